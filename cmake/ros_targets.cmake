@@ -1,0 +1,1 @@
+# Targets of the ROS layer (nodelet, nodes). Included after the core targets.

@@ -1,0 +1,1 @@
+# rostests of the ROS layer. Included after the core tests when testing is enabled.

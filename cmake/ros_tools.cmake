@@ -1,0 +1,1 @@
+# Targets of the ROS tools (calibration publishers, bag converter).

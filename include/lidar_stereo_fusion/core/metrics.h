@@ -1,0 +1,41 @@
+// KITTI depth-completion metrics and disparity bad-pixel rates.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "lidar_stereo_fusion/core/types.h"
+
+namespace lidar_stereo_fusion {
+
+/// Scores of one image over the pixels where the reference has a value.
+struct DepthMetrics {
+  double mae_mm = 0, rmse_mm = 0;        ///< depth errors [mm]
+  double imae_per_km = 0, irmse_per_km = 0;  ///< inverse-depth errors [1/km]
+  double bad2 = 0, bad3 = 0, bad5 = 0;   ///< fraction of pixels with disparity error > 2/3/5 px
+  double coverage = 0;                   ///< fraction of reference pixels the estimate covers
+  int count = 0;                         ///< reference pixels scored
+};
+
+/// Scores `depth` [m] against `reference` [m] (0 = no value) over every reference pixel. Where
+/// the estimate has no value, it counts as depth 0 for MAE/RMSE (as the KITTI devkit does) unless
+/// `only_covered` is true; disparity errors use fx * B / z with the given camera.
+DepthMetrics evaluateDepth(const cv::Mat1f& depth, const cv::Mat1f& reference,
+                           const StereoCamera& camera, bool only_covered = false);
+
+/// Scores disparity maps directly (Middlebury): errors in px over reference pixels (> 0).
+struct DisparityMetrics {
+  double mae_px = 0, rmse_px = 0;
+  double bad1 = 0, bad2 = 0, bad3 = 0, bad5 = 0;
+  double coverage = 0;
+  int count = 0;
+};
+/// Pixels without estimate count as errors of the full reference disparity.
+DisparityMetrics evaluateDisparity(const cv::Mat1f& disparity, const cv::Mat1f& reference);
+
+/// Mean over images, each image weighted equally (KITTI devkit convention).
+DepthMetrics averageMetrics(const std::vector<DepthMetrics>& per_image);
+DisparityMetrics averageMetrics(const std::vector<DisparityMetrics>& per_image);
+
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,69 @@
+// Stage 3: LiDAR-guided PatchMatch stereo with slanted support windows (Bleyer et al. 2011 with
+// the LiDAR disparity term of Xu et al.). Plain PMS is the mode gamma = 0, use_lidar_bounds = false,
+// init_from_prior = false.
+#pragma once
+
+#include <cstdint>
+
+#include <opencv2/core.hpp>
+
+#include "lidar_stereo_fusion/core/upsampling.h"
+
+namespace lidar_stereo_fusion {
+
+struct PatchMatchParams {
+  int window_radius = 5;         ///< support window is (2r+1)^2 [px]; paper: best near size 10
+  int window_stride = 2;         ///< sample every k-th pixel of the window (speed; 1 = all)
+  double weight_delta = 10.0;    ///< delta of w = exp(-|I_p - I_p'|_1 / delta)
+  double alpha = 0.1;            ///< colour weight
+  double beta = 0.0;             ///< gradient weight
+  double gamma = 0.9;            ///< LiDAR disparity weight (alpha + beta + gamma = 1)
+  double lambda_col = 10.0;      ///< colour truncation (per-channel mean L1, 0..255 scale)
+  double lambda_grad = 2.0;      ///< gradient truncation
+  double lambda_disp = 2.0;      ///< disparity truncation [px]; also the cost where the prior is empty
+  int iterations = 3;
+  bool slanted = true;           ///< false: front-parallel windows (n = (0, 0, 1))
+  bool init_from_prior = true;   ///< d = prior where it exists, else random
+  bool use_lidar_bounds = true;  ///< limit d to the scan lines above/below (+- bound_margin)
+  double bound_margin = 1.0;     ///< [px]
+  double min_refine_range = 1.0; ///< floor of Delta_d_max between scan lines [px]
+  double min_disparity = 1.0;    ///< image-wide search range [px]
+  double max_disparity = 192.0;  ///< [px]
+  bool view_propagation = true;
+  bool lr_check = true;          ///< left-right consistency + hole filling + weighted median
+  double lr_max_diff = 1.0;      ///< [px]
+  int num_threads = 0;           ///< 0 = all cores
+  uint64_t seed = 42;
+  void validate() const;
+};
+
+/// Output of PatchMatch for the left view.
+struct PatchMatchResult {
+  cv::Mat1f disparity;      ///< dense left disparity [px], 0 where nothing could be filled
+  cv::Mat1f right_disparity;  ///< right view disparity [px] (when computed)
+  cv::Mat1b inconsistent;   ///< 255 where the left-right check failed (then filled)
+  cv::Mat3f planes;         ///< per-pixel plane (a, b, c): d = a x + b y + c
+};
+
+/// Inputs of one view.
+struct ViewInput {
+  cv::Mat image;            ///< BGR CV_8UC3 (or grey CV_8UC1) rectified image
+  cv::Mat1f prior;          ///< up-sampled LiDAR disparity of this view, 0 = empty (may be empty())
+  ScanLineBounds bounds;    ///< search bounds from the scan lines (may be empty())
+};
+
+/// Runs guided PatchMatch. Scratch buffers are reused across calls of the same object.
+class PatchMatchStereo {
+ public:
+  explicit PatchMatchStereo(const PatchMatchParams& params = PatchMatchParams());
+  void setParams(const PatchMatchParams& params);
+  const PatchMatchParams& params() const { return params_; }
+
+  /// left/right images must have the same size and type. Priors and bounds are optional.
+  PatchMatchResult compute(const ViewInput& left, const ViewInput& right);
+
+ private:
+  PatchMatchParams params_;
+};
+
+}  // namespace lidar_stereo_fusion

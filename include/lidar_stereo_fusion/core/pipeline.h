@@ -1,0 +1,82 @@
+// The whole method: projection -> up-sampling -> guided PatchMatch -> depth. ROS-free.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "lidar_stereo_fusion/core/depth.h"
+#include "lidar_stereo_fusion/core/lidar_projection.h"
+#include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/upsampling.h"
+
+namespace lidar_stereo_fusion {
+
+enum class Method {
+  kFusedBI,     ///< the paper: BI* prior + guided PatchMatch (default)
+  kFusedBF,     ///< BF* prior + guided PatchMatch
+  kPlainPMS,    ///< PatchMatch stereo without LiDAR (gamma = 0, no bounds, random init)
+  kLidarBI,     ///< BI* up-sampled LiDAR only
+  kLidarBF,     ///< BF* up-sampled LiDAR only
+};
+
+/// "fused_bi", "fused_bf", "pms", "lidar_bi", "lidar_bf".
+std::string methodName(Method method);
+/// Parses the names above; throws std::invalid_argument listing the valid names.
+Method parseMethod(const std::string& name);
+
+struct FusionParams {
+  Method method = Method::kFusedBI;
+  ProjectionParams projection;
+  BIParams bi;
+  BFParams bf;
+  PatchMatchParams patchmatch;
+  /// Parameters of the plain-PMS baseline (Bleyer: alpha 0.1, beta 0.9, window 35).
+  static PatchMatchParams plainPmsParams(PatchMatchParams base);
+  void validate() const;
+};
+
+/// Per-stage wall time [ms] and counts of one frame.
+struct FusionStats {
+  double projection_ms = 0, upsampling_ms = 0, patchmatch_ms = 0, depth_ms = 0, total_ms = 0;
+  int points_in_front = 0;      ///< points in the depth range in front of the camera
+  int points_projected = 0;     ///< points landing in the left image
+  int points_removed = 0;       ///< scan-line pixels removed by Algorithm 1 (left view)
+  double prior_coverage = 0;    ///< fraction of pixels with an up-sampled prior
+  double output_coverage = 0;   ///< fraction of pixels with an output disparity
+};
+
+struct FusionResult {
+  SparseDisparity sparse;   ///< stage 1 (left view)
+  cv::Mat1f prior;          ///< stage 2 (left view), 0 = empty
+  cv::Mat1f disparity;      ///< final disparity [px], 0 = no value
+  cv::Mat1f depth;          ///< final depth [m], 0 = no value
+  FusionStats stats;
+};
+
+/// One frame: rectified images (BGR CV_8UC3 or grey), the sweep, and LiDAR -> left optical frame.
+struct FusionInput {
+  cv::Mat left, right;
+  LidarCloud cloud;
+  Eigen::Isometry3d T_cam_lidar = Eigen::Isometry3d::Identity();
+  StereoCamera camera;
+};
+
+/// Stateless apart from reusable scratch buffers; not thread-safe (one object per thread).
+class FusionPipeline {
+ public:
+  explicit FusionPipeline(const FusionParams& params = FusionParams());
+  /// Validates and replaces the parameters (throws std::invalid_argument).
+  void setParams(const FusionParams& params);
+  const FusionParams& params() const { return params_; }
+
+  /// Throws std::invalid_argument on bad input (sizes, types, camera) with a message naming it.
+  FusionResult process(const FusionInput& input);
+
+ private:
+  FusionParams params_;
+  PatchMatchStereo patchmatch_;
+};
+
+}  // namespace lidar_stereo_fusion

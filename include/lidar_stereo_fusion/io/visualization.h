@@ -1,0 +1,24 @@
+// Pictures a person can look at: colourised disparity / depth / error maps. ROS-free.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "lidar_stereo_fusion/core/lidar_projection.h"
+
+namespace lidar_stereo_fusion {
+
+/// Colourises disparity [px] with a perceptual colour map scaled to [0, max_disparity]
+/// (max_disparity <= 0: the map's own maximum); empty pixels (0) are black. Returns BGR8.
+cv::Mat colorizeDisparity(const cv::Mat1f& disparity, double max_disparity = 0.0);
+
+/// Colourises depth [m] (near = warm), empty (0 / NaN) black. Returns BGR8.
+cv::Mat colorizeDepth(const cv::Mat1f& depth, double max_depth = 80.0);
+
+/// Absolute error |estimate - reference| in px, clipped at max_error, only where the reference has
+/// a value (elsewhere black). Returns BGR8.
+cv::Mat colorizeError(const cv::Mat1f& estimate, const cv::Mat1f& reference, double max_error = 5.0);
+
+/// Draws sparse LiDAR disparity as coloured dots over a darkened copy of `image`. Returns BGR8.
+cv::Mat overlaySparse(const cv::Mat& image, const cv::Mat1f& sparse, double max_disparity = 0.0);
+
+}  // namespace lidar_stereo_fusion
