@@ -13,17 +13,18 @@ namespace lidar_stereo_fusion {
 
 struct PatchMatchParams {
   int window_radius = 5;         ///< support window is (2r+1)^2 [px]; paper: best near size 10
-  int window_stride = 2;         ///< sample every k-th pixel of the window (speed; 1 = all)
+  int window_stride = 2;         ///< sample offsets that are multiples of k (speed; 1 = all)
   double weight_delta = 10.0;    ///< delta of w = exp(-|I_p - I_p'|_1 / delta)
   double alpha = 0.1;            ///< colour weight
   double beta = 0.0;             ///< gradient weight
   double gamma = 0.9;            ///< LiDAR disparity weight (alpha + beta + gamma = 1)
-  double lambda_col = 10.0;      ///< colour truncation (per-channel mean L1, 0..255 scale)
+  double lambda_col = 10.0;      ///< colour truncation (RGB L1 distance, 0..765 scale)
   double lambda_grad = 2.0;      ///< gradient truncation
   double lambda_disp = 2.0;      ///< disparity truncation [px]; also the cost where the prior is empty
   int iterations = 3;
   bool slanted = true;           ///< false: front-parallel windows (n = (0, 0, 1))
   bool init_from_prior = true;   ///< d = prior where it exists, else random
+  bool init_normal_from_prior = true;  ///< slanted: initial normal from the prior's local slope
   bool use_lidar_bounds = true;  ///< limit d to the scan lines above/below (+- bound_margin)
   double bound_margin = 1.0;     ///< [px]
   double min_refine_range = 1.0; ///< floor of Delta_d_max between scan lines [px]

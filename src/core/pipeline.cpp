@@ -1,0 +1,181 @@
+// The whole method, stage by stage: projection -> up-sampling -> guided PatchMatch -> depth.
+#include "lidar_stereo_fusion/core/pipeline.h"
+
+#include <chrono>
+#include <stdexcept>
+
+namespace lidar_stereo_fusion {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+bool usesLidar(Method m) { return m != Method::kPlainPMS; }
+bool usesPatchMatch(Method m) {
+  return m == Method::kFusedBI || m == Method::kFusedBF || m == Method::kPlainPMS;
+}
+bool usesBF(Method m) { return m == Method::kFusedBF || m == Method::kLidarBF; }
+
+double coverage(const cv::Mat1f& m) {
+  if (m.empty()) return 0.0;
+  return static_cast<double>(cv::countNonZero(m > 0.f)) / static_cast<double>(m.total());
+}
+
+void checkInput(const FusionInput& in) {
+  in.camera.validate();
+  if (in.left.empty() || in.right.empty()) throw std::invalid_argument("left or right image is empty");
+  if (in.left.size() != in.right.size()) {
+    throw std::invalid_argument("left and right images differ in size");
+  }
+  if (in.left.type() != in.right.type()) {
+    throw std::invalid_argument("left and right images differ in type");
+  }
+  if (in.left.type() != CV_8UC3 && in.left.type() != CV_8UC1) {
+    throw std::invalid_argument("images must be 8-bit BGR (CV_8UC3) or grey (CV_8UC1)");
+  }
+  if (in.left.cols != in.camera.width || in.left.rows != in.camera.height) {
+    throw std::invalid_argument("image size " + std::to_string(in.left.cols) + "x" +
+                                std::to_string(in.left.rows) + " differs from the camera's " +
+                                std::to_string(in.camera.width) + "x" +
+                                std::to_string(in.camera.height));
+  }
+}
+
+/// Stage 2 of one view: scan lines after Algorithm 1, the prior of the chosen up-sampler, bounds.
+struct ViewPrior {
+  ScanLines lines;
+  cv::Mat1f prior;
+  ScanLineBounds bounds;
+  int removed = 0;
+};
+
+ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
+                       const FusionParams& params) {
+  ViewPrior v;
+  v.prior = upsampleBI(sparse, image, params.bi, &v.removed, &v.lines);
+  if (usesBF(params.method)) v.prior = upsampleBF(sparse, params.bf);
+  v.bounds = computeScanLineBounds(v.lines, params.patchmatch.bound_margin);
+  return v;
+}
+
+}  // namespace
+
+std::string methodName(Method method) {
+  switch (method) {
+    case Method::kFusedBI: return "fused_bi";
+    case Method::kFusedBF: return "fused_bf";
+    case Method::kPlainPMS: return "pms";
+    case Method::kLidarBI: return "lidar_bi";
+    case Method::kLidarBF: return "lidar_bf";
+  }
+  return "unknown";
+}
+
+Method parseMethod(const std::string& name) {
+  for (Method m : {Method::kFusedBI, Method::kFusedBF, Method::kPlainPMS, Method::kLidarBI,
+                   Method::kLidarBF}) {
+    if (methodName(m) == name) return m;
+  }
+  throw std::invalid_argument("unknown method '" + name +
+                              "' (valid: fused_bi, fused_bf, pms, lidar_bi, lidar_bf)");
+}
+
+PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
+  // Bleyer et al. 2011: (1 - 0.9) colour + 0.9 gradient, 35x35 window, no LiDAR.
+  base.alpha = 0.1;
+  base.beta = 0.9;
+  base.gamma = 0.0;
+  base.window_radius = 17;
+  base.window_stride = 3;
+  base.init_from_prior = false;
+  base.use_lidar_bounds = false;
+  return base;
+}
+
+void FusionParams::validate() const {
+  projection.validate();
+  bi.validate();
+  bf.validate();
+  patchmatch.validate();
+}
+
+FusionPipeline::FusionPipeline(const FusionParams& params) { setParams(params); }
+
+void FusionPipeline::setParams(const FusionParams& params) {
+  params.validate();
+  params_ = params;
+  patchmatch_.setParams(params.method == Method::kPlainPMS
+                            ? FusionParams::plainPmsParams(params.patchmatch)
+                            : params.patchmatch);
+}
+
+FusionResult FusionPipeline::process(const FusionInput& input) {
+  checkInput(input);
+  const auto start = Clock::now();
+  const Method method = params_.method;
+  FusionResult result;
+  FusionStats& stats = result.stats;
+
+  // Stage 1: projection (left always, for stats and inspection; right only for fused methods).
+  auto t = Clock::now();
+  result.sparse = projectCloud(input.cloud, input.T_cam_lidar, input.camera, params_.projection,
+                               View::kLeft);
+  stats.points_in_front = result.sparse.points_in_front;
+  stats.points_projected = result.sparse.points_in_image;
+  if (usesLidar(method) && result.sparse.points_in_image == 0) {
+    throw std::invalid_argument(
+        "no LiDAR points land in the image (" + std::to_string(input.cloud.size()) +
+        " points, " + std::to_string(result.sparse.points_in_front) +
+        " in front of the camera): check the cloud and the LiDAR->camera transform");
+  }
+  const bool fused = method == Method::kFusedBI || method == Method::kFusedBF;
+  SparseDisparity right_sparse;
+  if (fused) {
+    right_sparse = projectCloud(input.cloud, input.T_cam_lidar, input.camera, params_.projection,
+                                View::kRight);
+  }
+  stats.projection_ms = msSince(t);
+
+  // Stage 2: up-sampling.
+  t = Clock::now();
+  ViewPrior left_prior, right_prior;
+  if (usesLidar(method)) {
+    left_prior = upsampleView(result.sparse, input.left, params_);
+    stats.points_removed = left_prior.removed;
+    result.prior = left_prior.prior;
+    stats.prior_coverage = coverage(result.prior);
+  }
+  if (fused) right_prior = upsampleView(right_sparse, input.right, params_);
+  stats.upsampling_ms = msSince(t);
+
+  // Stage 3: PatchMatch.
+  t = Clock::now();
+  if (usesPatchMatch(method)) {
+    ViewInput left{input.left, cv::Mat1f(), ScanLineBounds()};
+    ViewInput right{input.right, cv::Mat1f(), ScanLineBounds()};
+    if (fused) {
+      left.prior = left_prior.prior;
+      left.bounds = left_prior.bounds;
+      right.prior = right_prior.prior;
+      right.bounds = right_prior.bounds;
+    }
+    result.disparity = patchmatch_.compute(left, right).disparity;
+  } else {
+    result.disparity = result.prior.clone();
+  }
+  stats.patchmatch_ms = msSince(t);
+
+  // Stage 4: depth.
+  t = Clock::now();
+  result.depth = disparityToDepth(result.disparity, input.camera, params_.projection.max_depth);
+  stats.output_coverage = coverage(result.disparity);
+  stats.depth_ms = msSince(t);
+  stats.total_ms = msSince(start);
+  return result;
+}
+
+}  // namespace lidar_stereo_fusion
