@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds the package in a catkin workspace and runs every test:
+# core gtests (exact synthetic answers), data gtests (../shared/data), rostests (node, nodelet,
+# calibration, KITTI bag playback, RViz) and the launch-file check.
+# Usage: bash scripts/run_tests.sh            (from anywhere; the workspace goes to ./ws)
+# Env:   LSF_WS=<dir>       catkin workspace to use (default: <repo>/ws, ignored by git)
+#        LSF_DATA_DIR=<dir> the shared real data (default: <repo>/../shared/data)
+#        CI=true            data tests fail instead of skipping when the data is missing
+set -euo pipefail
+
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+WS=${LSF_WS:-$ROOT/ws}
+DATA=${LSF_DATA_DIR:-$(cd "$ROOT/.." && pwd)/shared/data}
+JOBS=${LSF_JOBS:-2}
+
+bash "$ROOT/scripts/install_deps.sh"
+
+# Debian's ROS uses the system Python; a pyenv python3 first on PATH breaks catkin.
+export PATH=/usr/bin:/bin:$PATH
+export ROS_HOME=${ROS_HOME:-$WS/ros_home}
+export ROS_LOG_DIR=${ROS_LOG_DIR:-$WS/ros_home/log}
+
+mkdir -p "$WS/src"
+ln -sfn "$ROOT" "$WS/src/lidar_stereo_fusion"
+cd "$WS"
+CMAKE_ARGS=(-DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release "-DLSF_DATA_DIR=$DATA")
+
+echo "== build (catkin workspace $WS)"
+catkin_make "${CMAKE_ARGS[@]}" -j"$JOBS" all
+# `run_tests` builds only the test targets, so `all` comes first.
+rm -rf "$WS/build/test_results"
+echo "== tests"
+set +e
+# shellcheck disable=SC1091
+source "$WS/devel/setup.bash"
+catkin_make "${CMAKE_ARGS[@]}" -j"$JOBS" run_tests
+run_status=$?
+set -e
+
+python3 "$ROOT/scripts/summarize_test_results.py" "$WS/build/test_results"
+summary_status=$?
+if [ $run_status -ne 0 ]; then
+  echo "run_tests exited with $run_status" >&2
+  exit $run_status
+fi
+exit $summary_status
