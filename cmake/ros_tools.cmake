@@ -1,1 +1,27 @@
-# Targets of the ROS tools (calibration publishers, bag converter).
+# Targets of the ROS tools (calibration publishers, bag converter). Included after the core
+# targets and cmake/ros_targets.cmake, with catkin already set up (cmake/ros_catkin.cmake).
+#
+#   autoware_calibration_publisher  static TF lidar -> camera (+ camera_info) from Autoware YAML
+#   kitti_calibration_publisher     static TF velodyne -> left -> right camera from KITTI calib
+#   kitti_to_bag                    KITTI raw drive -> ROS 1 bag with the rig's topics
+
+# ROS messages built from the ROS-free calibration readers; shared by the tools and their tests.
+add_library(${PROJECT_NAME}_calibration_msgs STATIC src/ros/calibration_msgs.cpp)
+target_include_directories(${PROJECT_NAME}_calibration_msgs SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
+target_link_libraries(${PROJECT_NAME}_calibration_msgs PUBLIC ${PROJECT_NAME}_core ${catkin_LIBRARIES})
+set_target_properties(${PROJECT_NAME}_calibration_msgs PROPERTIES POSITION_INDEPENDENT_CODE ON)
+if(catkin_EXPORTED_TARGETS)
+  add_dependencies(${PROJECT_NAME}_calibration_msgs ${catkin_EXPORTED_TARGETS})
+endif()
+
+add_executable(autoware_calibration_publisher src/ros/calibration_autoware_publisher.cpp)
+add_executable(kitti_calibration_publisher src/ros/calibration_kitti_publisher.cpp)
+add_executable(kitti_to_bag src/ros/kitti_to_bag.cpp)
+set(LSF_ROS_TOOLS autoware_calibration_publisher kitti_calibration_publisher kitti_to_bag)
+foreach(tool ${LSF_ROS_TOOLS})
+  target_link_libraries(${tool} ${PROJECT_NAME}_calibration_msgs)
+endforeach()
+
+install(TARGETS ${LSF_ROS_TOOLS} RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+install(FILES launch/calibration_autoware.launch launch/calibration_kitti.launch
+  DESTINATION ${CATKIN_PACKAGE_SHARE_DESTINATION}/launch)

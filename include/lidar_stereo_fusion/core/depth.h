@@ -9,11 +9,13 @@
 
 namespace lidar_stereo_fusion {
 
-/// z = fx * B / d [m]; 0 where d <= 0 or z > max_depth.
+/// z = fx * B / d [m]; 0 where d <= 0, d is not finite, or z > max_depth (when max_depth > 0).
+/// Throws std::invalid_argument on an invalid camera, a map whose size differs from the camera's
+/// (when camera.width > 0), or max_depth < 0.
 cv::Mat1f disparityToDepth(const cv::Mat1f& disparity, const StereoCamera& camera,
                            double max_depth = 0.0 /* 0 = no limit */);
 
-/// depth [m] -> disparity [px]; 0 where depth <= 0 or not finite.
+/// depth [m] -> disparity [px] = fx * B / z; 0 where depth <= 0 or not finite. Throws like above.
 cv::Mat1f depthToDisparity(const cv::Mat1f& depth, const StereoCamera& camera);
 
 struct ColoredPoint {
@@ -22,7 +24,9 @@ struct ColoredPoint {
 };
 
 /// X = (x - cx) z / fx, Y = (y - cy) z / fy, colour from `image` (BGR or grey).
-/// Pixels without depth are skipped; `stride` subsamples rows and columns.
+/// Pixels without depth (<= 0 / not finite) are skipped; `stride` (>= 1) subsamples rows and
+/// columns, starting at (0, 0). Points are in row-major order. Throws std::invalid_argument when the
+/// image and depth sizes differ, the image type is not CV_8UC3/CV_8UC1, or stride < 1.
 std::vector<ColoredPoint> makeColoredCloud(const cv::Mat1f& depth, const cv::Mat& image,
                                            const StereoCamera& camera, int stride = 1);
 

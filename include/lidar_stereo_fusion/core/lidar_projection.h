@@ -27,19 +27,33 @@ struct SparseDisparity {
 };
 
 /// Projects `cloud` with the rigid transform `T_cam_lidar` (LiDAR frame -> left optical frame)
-/// into `view`, rounding to the nearest pixel; d = fx * B / z. Non-finite points are skipped.
+/// into `view`; d = fx * B / z [px] with z [m] along the left optical axis. Sub-pixel coordinates
+/// are rounded to the nearest pixel, pixel i covering [i - 0.5, i + 0.5) (i = floor(u + 0.5)).
+/// In the right view the sub-pixel column is u_left - d, rounded by the same rule; the stored value
+/// is the same (positive) disparity d. Non-finite points and points outside
+/// [min_depth, max_depth] are skipped; the nearest point (largest d) wins a pixel, ties keep the
+/// first point of the cloud. Points with ring < 0 get ring -1 in the ring map.
+/// Throws std::invalid_argument for an invalid camera, params, a non-finite or non-rigid transform,
+/// or a ring index above 32767.
 SparseDisparity projectCloud(const LidarCloud& cloud, const Eigen::Isometry3d& T_cam_lidar,
                              const StereoCamera& camera, const ProjectionParams& params,
                              View view = View::kLeft);
 
 /// Recovers rings of a KITTI HDL-64E .bin sweep, stored laser by laser: a new laser starts where
-/// the azimuth atan2(y, x) crosses 0 going up. Writes ring 0.. into every point; returns the count.
+/// the azimuth atan2(y, x) crosses 0 going up (counted only after the current laser has passed the
+/// +-180 deg wrap, so azimuth jitter around 0 cannot split a laser). Writes ring 0.. into every
+/// point in storage order (on KITTI ring 0 is the highest beam); non-finite points get the ring of
+/// the points around them. Returns the number of rings (0 for an empty cloud).
 int recoverRingsBySweepOrder(LidarCloud& cloud);
 
-/// Recovers rings by binning the elevation angle atan2(z, hypot(x, y)) into `num_rings` bins
-/// spread between the observed minimum and maximum elevation (for clouds without a ring field and
-/// not in sweep order). Ring 0 is the lowest beam. Returns the number of non-empty rings.
-int recoverRingsByElevation(LidarCloud& cloud, int num_rings);
+/// Recovers rings from the elevation angle atan2(z, hypot(x, y)) for clouds without a ring field
+/// and not in sweep order, from sensors whose beams share one origin (VLS-128, Ouster, ...): the
+/// sorted elevations are split into beams at the (at most num_rings - 1) widest gaps that are at
+/// least `min_gap_deg` [deg] wide. Unlike uniform bins this follows non-uniform beam spacing
+/// (VLS-128: 0.11 deg in the centre, several degrees at the edges) and does not invent beams that
+/// returned nothing. Ring 0 is the lowest beam; non-finite points get -1. Returns the number of
+/// rings found (<= num_rings). Throws std::invalid_argument for num_rings < 1 or min_gap_deg < 0.
+int recoverRingsByElevation(LidarCloud& cloud, int num_rings, double min_gap_deg = 0.05);
 
 /// True when every point has ring >= 0.
 bool hasRings(const LidarCloud& cloud);

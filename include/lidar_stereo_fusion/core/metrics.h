@@ -18,9 +18,13 @@ struct DepthMetrics {
   int count = 0;                         ///< reference pixels scored
 };
 
-/// Scores `depth` [m] against `reference` [m] (0 = no value) over every reference pixel. Where
-/// the estimate has no value, it counts as depth 0 for MAE/RMSE (as the KITTI devkit does) unless
-/// `only_covered` is true; disparity errors use fx * B / z with the given camera.
+/// Scores `depth` [m] against `reference` [m] (0 / NaN = no value) over every reference pixel. Where
+/// the estimate has no value (<= 0 or not finite), it counts as depth 0 for MAE/RMSE (as the KITTI
+/// devkit does), as inverse depth 0 for iMAE/iRMSE (error 1/z_ref) and as disparity 0 for the bad-
+/// pixel rates (error fx B / z_ref), unless `only_covered` is true (then those pixels are skipped;
+/// `coverage` is always the covered fraction of all reference pixels). Disparity errors use
+/// fx * B / z with the given camera. Throws std::invalid_argument on a size mismatch or an invalid
+/// camera. An image without reference pixels gives count 0 and zero scores.
 DepthMetrics evaluateDepth(const cv::Mat1f& depth, const cv::Mat1f& reference,
                            const StereoCamera& camera, bool only_covered = false);
 
@@ -31,10 +35,12 @@ struct DisparityMetrics {
   double coverage = 0;
   int count = 0;
 };
-/// Pixels without estimate count as errors of the full reference disparity.
+/// Pixels without estimate (<= 0 or not finite) count as errors of the full reference disparity.
+/// Bad-pixel rates count errors strictly greater than 1/2/3/5 px. Throws on a size mismatch.
 DisparityMetrics evaluateDisparity(const cv::Mat1f& disparity, const cv::Mat1f& reference);
 
-/// Mean over images, each image weighted equally (KITTI devkit convention).
+/// Mean over images, each image weighted equally (KITTI devkit convention). Images with count 0
+/// are skipped; `count` is the total over images. No scored image: all zeros, count 0.
 DepthMetrics averageMetrics(const std::vector<DepthMetrics>& per_image);
 DisparityMetrics averageMetrics(const std::vector<DisparityMetrics>& per_image);
 

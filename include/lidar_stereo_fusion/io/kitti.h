@@ -13,6 +13,15 @@ namespace lidar_stereo_fusion {
 namespace kitti {
 
 /// Calibration of one KITTI raw drive date (calib_cam_to_cam.txt + calib_velo_to_cam.txt).
+///
+/// Conventions: P_rect_0i = K [I | t_i] projects points of the rectified cam-0 frame into image i,
+/// with t_i = K^-1 P_rect_0i[:, 3] the position of the rectified cam-0 origin in camera i's frame
+/// (t_i.x = -b_i, b_i the x offset of camera i from camera 0; P_rect_0i[0, 3] = -fx b_i when the
+/// other entries of the last column are 0). The left camera here is rectified cam 2, so
+///   T_cam_velo = Translation(t_2) * R_rect_00 * [R | T]_velo_to_cam,
+/// and K * (T_cam_velo * X) equals P_rect_02 * R_rect_00 * [R | T] * X exactly (the KITTI devkit's
+/// projection; its depth z is the same too). Baseline B = (P_rect_02[0, 3] - P_rect_03[0, 3]) / fx
+/// (> 0: cam 3 is to the right of cam 2, 0.532 m on 2011_09_26).
 struct Calibration {
   StereoCamera camera;                 ///< rectified cam 2 (left colour) with baseline to cam 3
   Eigen::Isometry3d T_cam_velo;        ///< Velodyne -> rectified cam 2 optical frame
@@ -41,6 +50,19 @@ struct Frame {
 };
 /// Lists frames of `drive_dir` that have image_02, image_03 and a velodyne .bin, sorted by name.
 std::vector<Frame> listFrames(const std::string& drive_dir);
+
+/// Images and sweep of one frame, checked: both images readable, BGR8, of the calibration's size.
+struct FrameData {
+  cv::Mat left, right;  ///< BGR CV_8UC3 rectified image_02 / image_03
+  LidarCloud cloud;     ///< the sweep, rings recovered by sweep order (0..63 on the HDL-64E)
+};
+/// Reads a frame. Throws std::runtime_error naming the file when an image is unreadable, the two
+/// images differ in size, or their size differs from `camera`'s (when camera.width > 0).
+FrameData loadFrame(const Frame& frame, const StereoCamera& camera);
+
+/// The folder holding a drive's calibration files: the parent of `drive_dir`
+/// (".../2011_09_26" for ".../2011_09_26/2011_09_26_drive_0009_sync").
+std::string calibrationDirOf(const std::string& drive_dir);
 
 /// Reads timestamps.txt lines ("2011-09-26 13:02:25.964389445") as seconds since the epoch (UTC).
 std::vector<double> readTimestamps(const std::string& path);
