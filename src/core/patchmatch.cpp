@@ -101,6 +101,7 @@ struct ViewState {
   cv::Mat2f grad;           ///< (gx, gy) of the grey image; empty when beta == 0
   cv::Mat1f prior;          ///< 0 = empty
   cv::Mat1f lo, hi, range;  ///< search bounds (empty: unbounded)
+  float d_min = 0.f, d_max = 0.f;  ///< the image's disparity range (see imageRange)
   std::vector<Plane> planes;
   std::vector<float> cost;
 
@@ -250,9 +251,7 @@ class Solver {
 
   /// Whether disparity d at (x, y) is inside the search range of the pixel.
   bool admissible(int x, int y, float d) const {
-    if (!(d >= static_cast<float>(p_.min_disparity) && d <= static_cast<float>(p_.max_disparity))) {
-      return false;
-    }
+    if (!(d >= self_.d_min && d <= self_.d_max)) return false;
     if (p_.use_lidar_bounds && self_.bounded(x, y)) {
       return d >= self_.lo(y, x) && d <= self_.hi(y, x);
     }
@@ -261,8 +260,8 @@ class Solver {
 
   /// Disparity interval [lo, hi] a random initial value is drawn from.
   void initRange(int x, int y, float& lo, float& hi) const {
-    lo = static_cast<float>(p_.min_disparity);
-    hi = static_cast<float>(p_.max_disparity);
+    lo = self_.d_min;
+    hi = self_.d_max;
     if (p_.use_lidar_bounds && self_.bounded(x, y)) {
       lo = std::max(lo, self_.lo(y, x));
       hi = std::min(hi, self_.hi(y, x));
@@ -352,7 +351,7 @@ class Solver {
     if (p_.use_lidar_bounds && self_.bounded(x, y)) {
       dd = std::max(self_.range(y, x), static_cast<float>(p_.min_refine_range));
     } else {
-      dd = 0.5f * static_cast<float>(p_.max_disparity - p_.min_disparity);
+      dd = 0.5f * (self_.d_max - self_.d_min);
     }
     float dn = 1.f;
     const float fx = static_cast<float>(x), fy = static_cast<float>(y);
@@ -426,7 +425,29 @@ void PatchMatchStereo::setParams(const PatchMatchParams& params) {
 
 namespace {
 
-void prepareView(const ViewInput& in, bool use_grad, float match_sign, ViewState& v) {
+/// The image's disparity range [d_min, d_max] (METHOD.md: used where fewer than two scan lines
+/// bound a pixel). With LiDAR bounds on, it is the range of the prior's disparities in this image
+/// widened by bound_margin and clipped to [min_disparity, max_disparity]; otherwise the latter.
+void imageRange(const ViewInput& in, const PatchMatchParams& p, float& d_min, float& d_max) {
+  d_min = static_cast<float>(p.min_disparity);
+  d_max = static_cast<float>(p.max_disparity);
+  if (!p.use_lidar_bounds || in.prior.empty()) return;
+  float lo = std::numeric_limits<float>::max(), hi = 0.f;
+  for (const float d : in.prior) {
+    if (d > 0.f) {
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+  }
+  if (hi <= 0.f) return;
+  const float margin = static_cast<float>(p.bound_margin);
+  d_min = std::max(d_min, lo - margin);
+  d_max = std::min(d_max, hi + margin);
+  if (d_max <= d_min) d_max = d_min + 2.f * margin + 1e-3f;
+}
+
+void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sign, ViewState& v) {
+  const bool use_grad = p.beta > 0;
   v.width = in.image.cols;
   v.height = in.image.rows;
   v.match_sign = match_sign;
@@ -452,6 +473,7 @@ void prepareView(const ViewInput& in, bool use_grad, float match_sign, ViewState
   v.lo = in.bounds.lo;
   v.hi = in.bounds.hi;
   v.range = in.bounds.range;
+  imageRange(in, p, v.d_min, v.d_max);
   v.planes.assign(static_cast<size_t>(v.width) * v.height, Plane{});
   v.cost.assign(static_cast<size_t>(v.width) * v.height, 0.f);
 }
@@ -600,7 +622,9 @@ void fillHoles(const ViewState& v, const cv::Mat1b& bad, int radius, float delta
       filled(y, x) = best == std::numeric_limits<float>::max() ? 0.f : std::max(0.f, best);
     }
   }
-  // Weighted median over the window of each filled pixel.
+  // Weighted median over the window of each filled pixel (weights exp(-L1 colour / delta)).
+  std::vector<float> lut(1024);
+  for (size_t i = 0; i < lut.size(); ++i) lut[i] = std::exp(-static_cast<float>(i) / delta);
   disparity = filled.clone();
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
@@ -611,12 +635,15 @@ void fillHoles(const ViewState& v, const cv::Mat1b& bad, int radius, float delta
       const cv::Vec3f& c = v.color(y, x);
       float total = 0.f;
       for (int yy = std::max(0, y - radius); yy <= std::min(v.height - 1, y + radius); ++yy) {
+        const float* frow = filled.ptr<float>(yy);
+        const cv::Vec3f* crow = v.color.ptr<cv::Vec3f>(yy);
         for (int xx = std::max(0, x - radius); xx <= std::min(v.width - 1, x + radius); ++xx) {
-          const float d = filled(yy, xx);
+          const float d = frow[xx];
           if (d <= 0.f) continue;
-          const cv::Vec3f& q = v.color(yy, xx);
-          const float w = std::exp(-(std::abs(q[0] - c[0]) + std::abs(q[1] - c[1]) +
-                                     std::abs(q[2] - c[2])) / delta);
+          const cv::Vec3f& q = crow[xx];
+          const int l1 = static_cast<int>(std::abs(q[0] - c[0]) + std::abs(q[1] - c[1]) +
+                                          std::abs(q[2] - c[2]));
+          const float w = lut[std::min<int>(l1, static_cast<int>(lut.size()) - 1)];
           samples.emplace_back(d, w);
           total += w;
         }
@@ -643,8 +670,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   checkInput(right, size, "right");
   const PatchMatchParams& p = params_;
   ViewState lv, rv;
-  prepareView(left, p.beta > 0, -1.f, lv);
-  prepareView(right, p.beta > 0, +1.f, rv);
+  prepareView(left, p, -1.f, lv);
+  prepareView(right, p, +1.f, rv);
   const bool two_views = p.view_propagation || p.lr_check;
 
   Solver left_solver(p, lv, rv);
