@@ -1,1 +1,53 @@
-# rostests of the ROS layer. Included after the core tests when testing is enabled.
+# Tests of the ROS layer (nodelet, node, launch files, RViz config). Included after the core tests
+# when testing is enabled, with catkin set up and the ROS targets defined.
+#
+#   test_ros_unit            conversions, sweep matching, parameter mapping (no ROS master)
+#   fusion_nodelet.test      rostest of the nodelet (test_fusion_node: synthetic input, bad input,
+#   fusion_node.test           lazy subscription, TF, live parameters, diagnostics); the same test
+#   fusion_approx_sync.test    source against the node, and with approximate sync
+#   rviz_screenshot.test     RViz with rviz/fusion.rviz under Xvfb draws the fused cloud
+#   roslaunch-check          every launch file in launch/
+
+find_package(rostest REQUIRED)
+
+set(LSF_ROS_TEST_DEFINITIONS
+  LSF_DATA_DIR="${LSF_DATA_DIR}" LSF_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
+  LSF_BINARY_DIR="${CMAKE_CURRENT_BINARY_DIR}")
+
+catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp)
+if(TARGET test_ros_unit)
+  target_link_libraries(test_ros_unit ${PROJECT_NAME}_ros)
+  target_compile_definitions(test_ros_unit PRIVATE ${LSF_ROS_TEST_DEFINITIONS})
+endif()
+
+# Synthetic street frames as ROS messages, shared by the rostest nodes.
+add_library(${PROJECT_NAME}_ros_test_input STATIC EXCLUDE_FROM_ALL test/ros/synthetic_input.cpp)
+target_link_libraries(${PROJECT_NAME}_ros_test_input PUBLIC ${PROJECT_NAME}_ros)
+
+# A rostest gtest node built by `tests` (catkin_make run_tests) after the nodelet and the node.
+function(lsf_add_ros_test_node target)
+  add_executable(${target} EXCLUDE_FROM_ALL ${ARGN})
+  target_link_libraries(${target} ${PROJECT_NAME}_ros_test_input ${GTEST_LIBRARIES})
+  target_include_directories(${target} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/test)
+  target_include_directories(${target} SYSTEM PRIVATE ${GTEST_INCLUDE_DIRS})
+  target_compile_definitions(${target} PRIVATE ${LSF_ROS_TEST_DEFINITIONS})
+  add_dependencies(${target} ${PROJECT_NAME}_ros fusion_node)
+  if(TARGET tests)
+    add_dependencies(tests ${target})
+  endif()
+endfunction()
+
+lsf_add_ros_test_node(test_fusion_node test/ros/test_fusion_node.cpp)
+add_rostest(test/ros/fusion_nodelet.test DEPENDENCIES test_fusion_node)
+add_rostest(test/ros/fusion_node.test DEPENDENCIES test_fusion_node)
+add_rostest(test/ros/fusion_approx_sync.test DEPENDENCIES test_fusion_node)
+
+# Launch files (tools' launch files too: their executables must exist).
+find_package(roslaunch REQUIRED)
+set(LSF_LAUNCH_CHECK_DEPENDS fusion_node ${PROJECT_NAME}_ros)
+foreach(tool autoware_calibration_publisher kitti_calibration_publisher)
+  if(TARGET ${tool})
+    list(APPEND LSF_LAUNCH_CHECK_DEPENDS ${tool})
+  endif()
+endforeach()
+roslaunch_add_file_check(launch IGNORE_UNSET_ARGS DEPENDENCIES ${LSF_LAUNCH_CHECK_DEPENDS})

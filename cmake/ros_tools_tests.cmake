@@ -1,1 +1,62 @@
-# Tests of the ROS tools.
+# Tests of the ROS tools (calibration publishers, KITTI -> bag converter). Included after the core
+# tests when testing is enabled, with catkin set up and the tool targets defined.
+
+find_package(rostest REQUIRED)
+
+# Compile definitions and includes shared by the tools' tests.
+function(lsf_tools_test_setup target)
+  target_link_libraries(${target} ${PROJECT_NAME}_calibration_msgs ${GTEST_LIBRARIES})
+  target_include_directories(${target} PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/test)
+  target_include_directories(${target} SYSTEM PRIVATE ${GTEST_INCLUDE_DIRS})
+  target_compile_definitions(${target} PRIVATE
+    LSF_DATA_DIR="${LSF_DATA_DIR}" LSF_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
+    LSF_BINARY_DIR="${CMAKE_CURRENT_BINARY_DIR}")
+endfunction()
+
+# A gtest executable run by rostest with the launch file `launch_file`; built by `tests`
+# (catkin_make run_tests / tests), after the executables in DEPENDS. With DATA_DIR_ARG the launch
+# file gets data_dir:=LSF_DATA_DIR.
+function(lsf_add_tools_rostest target launch_file)
+  cmake_parse_arguments(arg "DATA_DIR_ARG" "" "SOURCES;DEPENDS" ${ARGN})
+  add_executable(${target} EXCLUDE_FROM_ALL ${arg_SOURCES})
+  lsf_tools_test_setup(${target})
+  if(arg_DEPENDS)
+    add_dependencies(${target} ${arg_DEPENDS})
+  endif()
+  if(TARGET tests)
+    add_dependencies(tests ${target})
+  endif()
+  if(arg_DATA_DIR_ARG)
+    add_rostest(${launch_file} ARGS data_dir:=${LSF_DATA_DIR} DEPENDENCIES ${target})
+  else()
+    add_rostest(${launch_file} DEPENDENCIES ${target})
+  endif()
+endfunction()
+
+# Direction and content of the TF / camera_info messages (tf2 buffer, no ROS master).
+catkin_add_gtest(test_calibration_msgs test/ros/test_calibration_msgs.cpp)
+if(TARGET test_calibration_msgs)
+  lsf_tools_test_setup(test_calibration_msgs)
+endif()
+
+# The calibration publishers on the real Autoware and KITTI calibrations.
+lsf_add_tools_rostest(test_calibration_publishers test/ros/calibration_publishers.test DATA_DIR_ARG
+  SOURCES test/ros/test_calibration_publishers.cpp
+  DEPENDS autoware_calibration_publisher kitti_calibration_publisher)
+target_compile_definitions(test_calibration_publishers PRIVATE
+  LSF_AUTOWARE_PUBLISHER="$<TARGET_FILE:autoware_calibration_publisher>"
+  LSF_KITTI_PUBLISHER="$<TARGET_FILE:kitti_calibration_publisher>")
+
+# KITTI raw -> kitti_to_bag -> the fusion nodelet, compared with the offline kitti_runner.
+if(TARGET kitti_runner)
+  lsf_add_tools_rostest(test_kitti_bag test/ros/kitti_bag.test
+    SOURCES test/ros/test_kitti_bag.cpp
+    DEPENDS kitti_to_bag kitti_runner ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
+  target_include_directories(test_kitti_bag SYSTEM PRIVATE
+    ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})  # FusionStats.h
+  target_compile_definitions(test_kitti_bag PRIVATE
+    LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>" LSF_KITTI_RUNNER="$<TARGET_FILE:kitti_runner>")
+else()
+  message(WARNING "no kitti_runner target (tools/kitti_runner.cpp): test/ros/kitti_bag.test is "
+                  "not registered")
+endif()

@@ -15,16 +15,16 @@ struct BIParams {
   double max_jump_disp = 2.0;    ///< nor jumps in disparity larger than this [px]
   double max_disp_diff = 1.5;    ///< Algorithm 1 "Maxdisp": foreground must exceed d by this [px]
   double max_color_diff = 60.0;  ///< Algorithm 1 "Maxcolor": RGB L1 distance [0..765]
-  int search_lines = 2;          ///< Algorithm 1 looks at this many scan lines up and down (paper: 1)
-  int max_interp_rows = 60;      ///< Eq. 3 does not bridge scan lines further apart than this [rows]
+  int search_lines = 2;      ///< Algorithm 1 looks at this many scan lines up and down (paper: 1)
+  int max_interp_rows = 60;  ///< Eq. 3 does not bridge scan lines further apart than this [rows]
   void validate() const;
 };
 
 struct BFParams {
-  int radius = 6;             ///< half window [px]
-  double sigma_space = 4.0;   ///< spatial Gaussian sigma [px]
-  double sigma_range = 2.0;   ///< disparity-range Gaussian sigma [px] (against the nearest point)
-  int min_support = 1;        ///< pixels with fewer LiDAR neighbours stay empty
+  int radius = 6;            ///< half window [px]
+  double sigma_space = 4.0;  ///< spatial Gaussian sigma [px]
+  double sigma_range = 2.0;  ///< disparity-range Gaussian sigma [px] (against the nearest point)
+  int min_support = 1;       ///< pixels with fewer LiDAR neighbours stay empty
   void validate() const;
 };
 
@@ -34,34 +34,54 @@ struct ScanLines {
   cv::Mat1s ring;       ///< ring of the line at this pixel, -1 elsewhere
 };
 
-/// BI* step 1: interpolates each ring linearly along x between consecutive projected points.
-/// Points without a ring (ring < 0) are kept as single pixels.
+/// BI* step 1: interpolates each ring linearly along x between consecutive projected points
+/// (sorted by x): for x0 < x < x1, d = d0 + t (d1 - d0) and row = round(y0 + t (y1 - y0)),
+/// t = (x - x0) / (x1 - x0). Neighbours are bridged only when x1 - x0 <= max_gap_px and
+/// |d1 - d0| <= max_jump_disp. Where two lines hit one pixel the nearer (larger d) wins. Points
+/// without a ring (ring < 0, or an empty ring map) are kept as single pixels. Throws
+/// std::invalid_argument on an empty map, a ring map of another size, or values that are not
+/// finite and >= 0.
 ScanLines completeScanLines(const SparseDisparity& sparse, const BIParams& params);
 
 /// BI* step 2 (Algorithm 1): clears scan-line pixels that have, both above and below in their
-/// column (within `search_lines` scan lines), a pixel with disparity larger by more than
-/// max_disp_diff whose image colour is within max_color_diff of the colour at the pixel.
-/// `image` is the view's BGR image (CV_8UC3) or grey (CV_8UC1). Returns the number removed.
+/// column (within the next `search_lines` scan-line pixels; 1 = the paper's next scan line), a
+/// pixel with disparity larger by more than max_disp_diff whose image colour is within
+/// max_color_diff (strictly less, RGB L1) of the colour at the pixel. `image` is the view's BGR
+/// image (CV_8UC3) or grey (CV_8UC1, distance 3 |a - b| so the threshold means the same). Every
+/// decision is made on the input state (the pixels are cleared after all are decided), so the
+/// result does not depend on scan order. Cleared pixels get disparity 0 and ring -1. Returns the
+/// number removed. Throws std::invalid_argument for an image of another size or type.
 int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams& params);
 
 /// BI* step 3 (Eq. 3): linear interpolation in every column between the nearest scan lines above
-/// and below. Pixels above the top or below the bottom line stay 0.
+/// and below, when they are at most max_interp_rows apart. Pixels on a line keep its value;
+/// pixels above the top or below the bottom line stay 0.
 cv::Mat1f interpolateBetweenScanLines(const ScanLines& lines, const BIParams& params);
 
-/// The whole BI* chain. `removed` (optional) receives the Algorithm 1 count.
+/// The whole BI* chain. `removed` (optional) receives the Algorithm 1 count; `lines_out`
+/// (optional) the scan lines after Algorithm 1, i.e. the lines Eq. 3 interpolated (the input of
+/// computeScanLineBounds).
 cv::Mat1f upsampleBI(const SparseDisparity& sparse, const cv::Mat& image, const BIParams& params,
                      int* removed = nullptr, ScanLines* lines_out = nullptr);
 
-/// BF*: bilateral up-sampling of the sparse disparity (no occlusion handling, as in the paper's
-/// comparison). Pixels without support stay 0.
+/// BF*: bilateral up-sampling of the sparse disparity (Premebida et al. 2016; no occlusion
+/// handling, as in the paper's comparison). For every pixel p, over the LiDAR points q of the
+/// (2 radius + 1)^2 window: ref = the largest disparity (the nearest point), w_q =
+/// exp(-|p - q|^2 / (2 sigma_space^2)) * exp(-(ref - d_q)^2 / (2 sigma_range^2)), D(p) = sum w_q
+/// d_q / sum w_q (a constant neighbourhood comes back exactly). Every pixel is filtered, LiDAR
+/// pixels included; pixels with fewer than min_support points in the window stay 0. Rows run in
+/// parallel with OpenMP on large maps.
 cv::Mat1f upsampleBF(const SparseDisparity& sparse, const BFParams& params);
 
 /// Per-pixel search bounds from the scan lines above and below each pixel (paper Sec. III-D):
-/// lo/hi = min/max of the line disparities -/+ margin; range = |d_up - d_down|.
-/// Pixels with fewer than two lines in their column get lo = hi = range = 0 (meaning "unbounded").
+/// d_up / d_down are the nearest line pixels strictly above / below in the column (a pixel on a
+/// line uses the lines around it); lo/hi = min/max(d_up, d_down) -/+ margin; range =
+/// |d_up - d_down|. Pixels without a line both above and below get lo = hi = range = 0 (meaning
+/// "unbounded"); a pixel is bounded exactly when hi > 0 (lo may be <= 0). No row limit applies.
+/// Throws std::invalid_argument for an empty map or a negative / non-finite margin.
 struct ScanLineBounds {
-  cv::Mat1f lo, hi;   ///< [px]
-  cv::Mat1f range;    ///< Delta_d_max for plane refinement [px]
+  cv::Mat1f lo, hi;  ///< [px]
+  cv::Mat1f range;   ///< Delta_d_max for plane refinement [px]
 };
 ScanLineBounds computeScanLineBounds(const ScanLines& lines, double margin_px);
 

@@ -1,0 +1,35 @@
+// Middlebury 2003 stereo scenes (cones, teddy) and a pseudo-LiDAR sampled from their ground truth.
+// ROS-free.
+#pragma once
+
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "lidar_stereo_fusion/core/lidar_projection.h"
+
+namespace lidar_stereo_fusion {
+
+/// One scene: im2 (left), im6 (right), disp2 (left ground truth).
+struct MiddleburyScene {
+  cv::Mat left, right;   ///< BGR CV_8UC3
+  cv::Mat1f disparity;   ///< left ground-truth disparity [px] = PNG value / scale, 0 = unknown
+};
+
+/// Reads `dir`/im2.png, im6.png and disp2.png (quarter size: disparity_scale = 4). Throws
+/// std::runtime_error naming the file when one is missing, unreadable, not 8-bit, or of another
+/// size; std::invalid_argument when disparity_scale <= 0.
+MiddleburyScene readMiddleburyScene(const std::string& dir, double disparity_scale = 4.0);
+
+/// Pseudo-LiDAR: `num_rows` evenly spaced rows of `disparity` (row of ring i is
+/// floor((i + 0.5) * rows / num_rows), ring 0 at the top); every pixel of those rows where the
+/// ground truth is > 0 becomes a sample of that ring. points_in_front / points_in_image count the
+/// samples. Throws std::invalid_argument when num_rows < 2 or num_rows > rows.
+SparseDisparity sampleRowsAsScanLines(const cv::Mat1f& disparity, int num_rows);
+
+/// The same samples seen from the right view: the sample at (x, y) with disparity d moves to
+/// column floor(x - d + 0.5) (as projectCloud's right view does), keeps d and its ring; the larger
+/// disparity wins a pixel; samples leaving the image are dropped.
+SparseDisparity shiftToRightView(const SparseDisparity& left);
+
+}  // namespace lidar_stereo_fusion

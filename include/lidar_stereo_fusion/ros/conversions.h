@@ -1,0 +1,106 @@
+// Conversions between ROS messages and the ROS-free core types. No algorithm here: only type
+// conversion and the checks that belong where data enters (encodings, sizes, fields, NaN).
+//
+// Conventions (REP 103 / REP 118, stereo_image_proc):
+//  * Images are rectified; the left view is the reference and its optical frame (x right, y down,
+//    z forward) is the frame of every output.
+//  * Disparity [px]: the core stores 0 for "no value"; stereo_msgs/DisparityImage marks it by a
+//    value below min_disparity, which 0 is.
+//  * Depth [m] in sensor_msgs/Image 32FC1, NaN = no value (REP 118).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_msgs/Header.h>
+#include <stereo_msgs/DisparityImage.h>
+
+#include "lidar_stereo_fusion/core/depth.h"
+#include "lidar_stereo_fusion/core/types.h"
+
+namespace lidar_stereo_fusion {
+namespace conversions {
+
+/// Thrown for input that cannot be converted; what() names the problem (not the topic: the caller
+/// knows which topic the message came from).
+class ConversionError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Image encodings accepted for the stereo pair: bgra8 (ZED), rgba8, bgr8, rgb8, mono8.
+const std::vector<std::string>& supportedImageEncodings();
+
+/// Checks encoding, size and step of an image message without converting it; returns an empty
+/// string when it is usable, else a description of the problem.
+std::string checkImage(const sensor_msgs::Image& msg);
+
+/// Converts one rectified image to what the core takes: BGR CV_8UC3 for colour encodings, CV_8UC1
+/// for mono8. The result may share memory with `msg` (bgr8, mono8): keep `msg` alive while using
+/// it. Throws ConversionError on an unsupported encoding or a malformed message.
+cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg);
+
+/// Converts a stereo pair; the two results have the same type (mono + colour: both BGR).
+/// Throws ConversionError when either image is unusable or the sizes differ.
+void stereoPairToCore(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right,
+                      cv::Mat& left_out, cv::Mat& right_out);
+
+/// Rectified stereo camera from the two camera_infos: fx, fy, cx, cy from the left projection
+/// matrix P; baseline B [m] = |Tx_right - Tx_left| / fx with Tx = P[3] (so both sign conventions,
+/// Tx = -fx * B as in ROS and +fx * B as some drivers write it, work). Throws ConversionError
+/// (naming "left"/"right" and the field) when P is zero, the focal lengths disagree or B is 0.
+StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
+                                  const sensor_msgs::CameraInfo& right);
+
+/// Result of converting a sensor_msgs/PointCloud2 sweep.
+struct CloudConversion {
+  LidarCloud cloud;       ///< finite points only, in the cloud's frame [m]
+  bool has_ring = false;  ///< the message had a `ring` field (points carry it)
+  bool has_time = false;  ///< the message had a `time` field [s within the sweep]
+  int total_points = 0;   ///< width * height of the message
+  int non_finite = 0;     ///< points skipped because x, y or z was NaN / inf
+};
+
+/// Checks the layout of a cloud without reading its points: x, y, z fields present with a numeric
+/// type, point_step / row_step / data size consistent, little-endian. Returns an empty string when
+/// usable, else the problem.
+std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg);
+
+/// Reads a sweep as velodyne_pointcloud publishes it (x, y, z, intensity, ring, time) or any other
+/// layout with at least x, y, z. `intensity`, `ring` and `time` are optional and may have any
+/// numeric datatype (float32/64, (u)int8/16/32). Non-finite points are skipped and counted.
+/// Throws ConversionError when checkCloudLayout() fails.
+CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg);
+
+/// Writes a core cloud as PointCloud2 with float32 x, y, z, intensity, uint16 ring, float32 time
+/// (the velodyne_pointcloud layout). Used by tests and tools.
+sensor_msgs::PointCloud2 cloudToMsg(const LidarCloud& cloud, const std_msgs::Header& header);
+
+/// Disparity [px] (0 = no value) as stereo_msgs/DisparityImage filled as stereo_image_proc does:
+/// f = fx [px], T = baseline [m], min/max_disparity = the search range widened to the values
+/// present, delta_d = the nominal sub-pixel step, valid_window = bounding box of valid pixels.
+stereo_msgs::DisparityImagePtr disparityToMsg(const cv::Mat1f& disparity,
+                                              const std_msgs::Header& header,
+                                              const StereoCamera& camera, double min_search,
+                                              double max_search);
+
+/// Depth [m] (0 = no value) as a 32FC1 image with NaN = no value (REP 118). Values beyond
+/// `max_depth` (> 0) are also NaN.
+sensor_msgs::ImagePtr depthToMsg(const cv::Mat1f& depth, const std_msgs::Header& header,
+                                 double max_depth = 0.0);
+
+/// A float map as a 32FC1 image, unchanged (e.g. the LiDAR prior: disparity [px], 0 = empty).
+sensor_msgs::ImagePtr floatImageToMsg(const cv::Mat1f& image, const std_msgs::Header& header);
+
+/// Coloured points (left optical frame [m]) as PointCloud2 with float32 x, y, z and rgb packed as
+/// in PCL / depth_image_proc (0x00RRGGBB in the bytes of a float32). Unorganised, dense.
+sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const std::vector<ColoredPoint>& points,
+                                              const std_msgs::Header& header);
+
+}  // namespace conversions
+}  // namespace lidar_stereo_fusion

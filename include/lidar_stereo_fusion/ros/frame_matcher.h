@@ -1,0 +1,142 @@
+// Matching LiDAR sweeps to synchronised image sets by stamp. Header-only, no I/O, unit-tested.
+//
+// velodyne_pointcloud stamps a sweep at its last packet, so the sweep that covers an image is
+// usually stamped after it and arrives after it. An image set therefore waits (pending) until a
+// sweep stamped at or after the image has arrived -- from then on no later sweep can be nearer --
+// or until it has waited `max_wait` (wall time), and then takes the sweep nearest in time, looking
+// both ways, if that is within `max_time_offset`; otherwise it is given up ("unmatched").
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <deque>
+#include <utility>
+#include <vector>
+
+#include <ros/time.h>
+
+namespace lidar_stereo_fusion {
+
+template <class Images, class Sweep>
+class FrameMatcher {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  struct Params {
+    double max_time_offset = 0.1;   ///< [s] largest |sweep stamp - image stamp| accepted
+    double max_wait = 0.3;          ///< [s] wall time an image set waits for a later sweep
+    std::size_t sweep_buffer_size = 10;  ///< recent sweeps kept
+    std::size_t max_pending = 4;    ///< image sets waiting at most; the oldest is decided first
+  };
+
+  struct Match {
+    Images images;
+    Sweep sweep;
+    ros::Time image_stamp, sweep_stamp;
+  };
+
+  /// What one call decided.
+  struct Events {
+    std::vector<Match> ready;          ///< matched sets, oldest first
+    std::vector<ros::Time> unmatched;  ///< image stamps given up: no sweep within max_time_offset
+    bool out_of_order = false;  ///< the message passed in was not newer than the last one (dropped)
+  };
+
+  explicit FrameMatcher(const Params& params = Params()) : params_(params) {}
+  void setParams(const Params& params) { params_ = params; }
+  const Params& params() const { return params_; }
+
+  /// Adds a synchronised image set stamped `stamp`.
+  Events addImages(const ros::Time& stamp, Images images, Clock::time_point now) {
+    Events events;
+    if (have_image_ && stamp <= last_image_stamp_) {
+      events.out_of_order = true;
+      return events;
+    }
+    have_image_ = true;
+    last_image_stamp_ = stamp;
+    pending_.push_back({stamp, std::move(images), now});
+    resolve(events, now);
+    return events;
+  }
+
+  /// Adds a sweep stamped `stamp`.
+  Events addSweep(const ros::Time& stamp, Sweep sweep, Clock::time_point now) {
+    Events events;
+    if (!sweeps_.empty() && stamp <= sweeps_.back().first) {
+      events.out_of_order = true;
+      return events;
+    }
+    sweeps_.emplace_back(stamp, std::move(sweep));
+    while (sweeps_.size() > std::max<std::size_t>(params_.sweep_buffer_size, 1)) sweeps_.pop_front();
+    resolve(events, now);
+    return events;
+  }
+
+  /// Decides sets that have waited long enough; call periodically.
+  Events poll(Clock::time_point now) {
+    Events events;
+    resolve(events, now);
+    return events;
+  }
+
+  /// Forgets everything (e.g. when the ROS clock jumps back). Returns the pending sets dropped.
+  std::size_t clear() {
+    const std::size_t n = pending_.size();
+    pending_.clear();
+    sweeps_.clear();
+    have_image_ = false;
+    return n;
+  }
+
+  std::size_t pendingCount() const { return pending_.size(); }
+  std::size_t sweepCount() const { return sweeps_.size(); }
+
+ private:
+  struct Pending {
+    ros::Time stamp;
+    Images images;
+    Clock::time_point arrival;
+  };
+
+  void resolve(Events& events, Clock::time_point now) {
+    const auto max_wait = std::chrono::duration<double>(params_.max_wait);
+    while (!pending_.empty()) {
+      Pending& p = pending_.front();
+      const bool later_sweep_seen = !sweeps_.empty() && sweeps_.back().first >= p.stamp;
+      const bool waited_enough = now - p.arrival >= max_wait;
+      const bool too_many = pending_.size() > std::max<std::size_t>(params_.max_pending, 1);
+      if (!later_sweep_seen && !waited_enough && !too_many) break;  // later ones wait too
+      const auto best = nearestSweep(p.stamp);
+      if (best != nullptr) {
+        events.ready.push_back({std::move(p.images), best->second, p.stamp, best->first});
+      } else {
+        events.unmatched.push_back(p.stamp);
+      }
+      pending_.pop_front();
+    }
+  }
+
+  const std::pair<ros::Time, Sweep>* nearestSweep(const ros::Time& stamp) const {
+    const std::pair<ros::Time, Sweep>* best = nullptr;
+    double best_dt = params_.max_time_offset;
+    for (const auto& s : sweeps_) {
+      const double dt = std::abs((s.first - stamp).toSec());
+      if (dt <= best_dt) {
+        best_dt = dt;
+        best = &s;
+      }
+    }
+    return best;
+  }
+
+  Params params_;
+  std::deque<Pending> pending_;
+  std::deque<std::pair<ros::Time, Sweep>> sweeps_;
+  bool have_image_ = false;
+  ros::Time last_image_stamp_;
+};
+
+}  // namespace lidar_stereo_fusion

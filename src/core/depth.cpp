@@ -1,0 +1,94 @@
+// Stage 4: disparity -> depth (z = fx B / d) and the coloured point cloud of the left view.
+#include "lidar_stereo_fusion/core/depth.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace lidar_stereo_fusion {
+namespace {
+
+bool hasValue(float v) { return std::isfinite(v) && v > 0.f; }
+
+void requireCameraSize(const cv::Mat& map, const StereoCamera& camera, const char* who) {
+  camera.validate();
+  if (map.empty()) throw std::invalid_argument(std::string(who) + ": empty input map");
+  if (camera.width > 0 && (map.cols != camera.width || map.rows != camera.height)) {
+    throw std::invalid_argument(std::string(who) + ": map is " + std::to_string(map.cols) + "x" +
+                                std::to_string(map.rows) + " but the camera is " +
+                                std::to_string(camera.width) + "x" +
+                                std::to_string(camera.height));
+  }
+}
+
+}  // namespace
+
+cv::Mat1f disparityToDepth(const cv::Mat1f& disparity, const StereoCamera& camera,
+                           double max_depth) {
+  requireCameraSize(disparity, camera, "disparityToDepth");
+  if (!(max_depth >= 0.0)) {
+    throw std::invalid_argument("disparityToDepth: max_depth must be >= 0 (0 = no limit)");
+  }
+  const double fb = camera.fx * camera.baseline;
+  cv::Mat1f depth(disparity.size(), 0.f);
+  for (int y = 0; y < disparity.rows; ++y) {
+    for (int x = 0; x < disparity.cols; ++x) {
+      const float d = disparity(y, x);
+      if (!hasValue(d)) continue;
+      const double z = fb / d;
+      if (max_depth > 0.0 && z > max_depth) continue;
+      depth(y, x) = static_cast<float>(z);
+    }
+  }
+  return depth;
+}
+
+cv::Mat1f depthToDisparity(const cv::Mat1f& depth, const StereoCamera& camera) {
+  requireCameraSize(depth, camera, "depthToDisparity");
+  const double fb = camera.fx * camera.baseline;
+  cv::Mat1f disparity(depth.size(), 0.f);
+  for (int y = 0; y < depth.rows; ++y) {
+    for (int x = 0; x < depth.cols; ++x) {
+      const float z = depth(y, x);
+      if (hasValue(z)) disparity(y, x) = static_cast<float>(fb / z);
+    }
+  }
+  return disparity;
+}
+
+std::vector<ColoredPoint> makeColoredCloud(const cv::Mat1f& depth, const cv::Mat& image,
+                                           const StereoCamera& camera, int stride) {
+  requireCameraSize(depth, camera, "makeColoredCloud");
+  if (image.size() != depth.size()) {
+    throw std::invalid_argument("makeColoredCloud: image is " + std::to_string(image.cols) + "x" +
+                                std::to_string(image.rows) + " but depth is " +
+                                std::to_string(depth.cols) + "x" + std::to_string(depth.rows));
+  }
+  if (image.type() != CV_8UC3 && image.type() != CV_8UC1) {
+    throw std::invalid_argument("makeColoredCloud: image must be BGR CV_8UC3 or grey CV_8UC1");
+  }
+  if (stride < 1) throw std::invalid_argument("makeColoredCloud: stride must be >= 1");
+  std::vector<ColoredPoint> cloud;
+  for (int y = 0; y < depth.rows; y += stride) {
+    for (int x = 0; x < depth.cols; x += stride) {
+      const float z = depth(y, x);
+      if (!hasValue(z)) continue;
+      ColoredPoint p;
+      p.x = static_cast<float>((x - camera.cx) * z / camera.fx);
+      p.y = static_cast<float>((y - camera.cy) * z / camera.fy);
+      p.z = z;
+      if (image.type() == CV_8UC3) {
+        const cv::Vec3b bgr = image.at<cv::Vec3b>(y, x);
+        p.b = bgr[0];
+        p.g = bgr[1];
+        p.r = bgr[2];
+      } else {
+        p.r = p.g = p.b = image.at<uint8_t>(y, x);
+      }
+      cloud.push_back(p);
+    }
+  }
+  return cloud;
+}
+
+}  // namespace lidar_stereo_fusion

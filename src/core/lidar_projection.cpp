@@ -1,0 +1,197 @@
+// Stage 1: LiDAR projection (paper Eq. 1-2) and scan-line (ring) recovery.
+#include "lidar_stereo_fusion/core/lidar_projection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace lidar_stereo_fusion {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Nearest pixel of a sub-pixel coordinate: pixel i covers [i - 0.5, i + 0.5) (OpenCV centres).
+inline int roundToPixel(double u) { return static_cast<int>(std::floor(u + 0.5)); }
+
+inline bool isFinite(const LidarPoint& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+
+void validateTransform(const Eigen::Isometry3d& T) {
+  if (!T.matrix().allFinite()) {
+    throw std::invalid_argument("projectCloud: T_cam_lidar contains NaN or inf");
+  }
+  const Eigen::Matrix3d R = T.linear();
+  const double orthogonality_error = (R * R.transpose() - Eigen::Matrix3d::Identity()).norm();
+  if (orthogonality_error > 1e-3 || R.determinant() < 0.0) {
+    throw std::invalid_argument(
+        "projectCloud: T_cam_lidar rotation is not a proper rotation (|R R^T - I| = " +
+        std::to_string(orthogonality_error) + ", det = " + std::to_string(R.determinant()) + ")");
+  }
+}
+
+/// Ring index as stored in the cv::Mat1s ring map; -1 for unknown.
+short ringToShort(int ring) {
+  if (ring < 0) return -1;
+  if (ring > std::numeric_limits<short>::max()) {
+    throw std::invalid_argument("projectCloud: ring index " + std::to_string(ring) +
+                                " does not fit the ring map (max " +
+                                std::to_string(std::numeric_limits<short>::max()) + ")");
+  }
+  return static_cast<short>(ring);
+}
+
+}  // namespace
+
+void ProjectionParams::validate() const {
+  if (!std::isfinite(min_depth) || min_depth <= 0.0) {
+    throw std::invalid_argument("ProjectionParams: min_depth must be finite and > 0 [m], got " +
+                                std::to_string(min_depth));
+  }
+  if (!std::isfinite(max_depth) || max_depth <= min_depth) {
+    throw std::invalid_argument(
+        "ProjectionParams: max_depth must be finite and > min_depth [m], "
+        "got " +
+        std::to_string(max_depth));
+  }
+}
+
+SparseDisparity projectCloud(const LidarCloud& cloud, const Eigen::Isometry3d& T_cam_lidar,
+                             const StereoCamera& camera, const ProjectionParams& params,
+                             View view) {
+  camera.validate();
+  params.validate();
+  validateTransform(T_cam_lidar);
+
+  SparseDisparity out;
+  out.disparity.create(camera.height, camera.width);
+  out.disparity.setTo(0.f);
+  out.ring.create(camera.height, camera.width);
+  out.ring.setTo(-1);
+
+  const Eigen::Matrix3d R = T_cam_lidar.linear();
+  const Eigen::Vector3d t = T_cam_lidar.translation();
+  const double fxb = camera.fx * camera.baseline;
+  const bool right = view == View::kRight;
+
+  for (const LidarPoint& point : cloud) {
+    if (!isFinite(point)) continue;
+    const Eigen::Vector3d p = R * Eigen::Vector3d(point.x, point.y, point.z) + t;
+    const double z = p.z();
+    if (z < params.min_depth || z > params.max_depth) continue;
+    ++out.points_in_front;
+    const double d = fxb / z;
+    const double u_left = camera.fx * p.x() / z + camera.cx;
+    const double v = camera.fy * p.y() / z + camera.cy;
+    // Right view: the same point seen at x_right = x_left - d (rectified, parallel axes); the
+    // sub-pixel x_right is rounded, not round(x_left) - d.
+    const int col = roundToPixel(right ? u_left - d : u_left);
+    const int row = roundToPixel(v);
+    if (col < 0 || col >= camera.width || row < 0 || row >= camera.height) continue;
+    ++out.points_in_image;
+    float& stored = out.disparity(row, col);
+    const float df = static_cast<float>(d);
+    if (df > stored) {  // z-buffer: the nearest point (largest disparity) wins; ties keep the first
+      stored = df;
+      out.ring(row, col) = ringToShort(point.ring);
+    }
+  }
+  return out;
+}
+
+int recoverRingsBySweepOrder(LidarCloud& cloud) {
+  // A laser's azimuth rises from just left of straight ahead (small positive), passes the +-180 deg
+  // wrap behind the car, and ends just right of straight ahead (small negative). The next laser
+  // therefore starts where the azimuth crosses 0 going up. The crossing only counts once the
+  // current laser has passed the wrap, so jitter of the azimuth around 0 at a laser's first
+  // points cannot start a spurious ring. Non-finite points take the ring of their neighbours.
+  int ring = 0;
+  bool passed_wrap = false;
+  bool have_previous = false;
+  double previous = 0.0;
+  for (LidarPoint& point : cloud) {
+    if (isFinite(point)) {
+      const double azimuth = std::atan2(point.y, point.x);
+      if (have_previous) {
+        if (previous > 0.0 && azimuth < 0.0 && previous - azimuth > kPi) passed_wrap = true;
+        if (passed_wrap && previous < 0.0 && azimuth >= 0.0 && azimuth - previous < kPi) {
+          ++ring;
+          passed_wrap = false;
+        }
+      }
+      previous = azimuth;
+      have_previous = true;
+    }
+    point.ring = ring;
+  }
+  return cloud.empty() ? 0 : ring + 1;
+}
+
+int recoverRingsByElevation(LidarCloud& cloud, int num_rings, double min_gap_deg) {
+  if (num_rings < 1) {
+    throw std::invalid_argument("recoverRingsByElevation: num_rings must be >= 1, got " +
+                                std::to_string(num_rings));
+  }
+  if (!std::isfinite(min_gap_deg) || min_gap_deg < 0.0) {
+    throw std::invalid_argument(
+        "recoverRingsByElevation: min_gap_deg must be finite and >= 0, "
+        "got " +
+        std::to_string(min_gap_deg));
+  }
+  std::vector<double> elevation(cloud.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> sorted;
+  sorted.reserve(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const LidarPoint& p = cloud[i];
+    if (!isFinite(p)) continue;
+    elevation[i] = std::atan2(p.z, std::hypot(p.x, p.y)) * 180.0 / kPi;
+    sorted.push_back(elevation[i]);
+  }
+  if (sorted.empty()) {
+    for (LidarPoint& p : cloud) p.ring = -1;
+    return 0;
+  }
+  std::sort(sorted.begin(), sorted.end());
+
+  // Beams are the clusters of the sorted elevations: split at the num_rings - 1 widest gaps, but
+  // only at gaps of at least min_gap_deg (a beam's own points are far closer together than that).
+  std::vector<std::pair<double, std::size_t>> gaps;  // (width, index of the value above the gap)
+  gaps.reserve(sorted.size());
+  for (std::size_t i = 1; i < sorted.size(); ++i) {
+    const double width = sorted[i] - sorted[i - 1];
+    if (width >= min_gap_deg && width > 0.0) gaps.emplace_back(width, i);
+  }
+  const std::size_t num_cuts = std::min(gaps.size(), static_cast<std::size_t>(num_rings - 1));
+  std::partial_sort(gaps.begin(), gaps.begin() + num_cuts, gaps.end(),
+                    [](const auto& a, const auto& b) {
+                      return a.first > b.first || (a.first == b.first && a.second < b.second);
+                    });
+  std::vector<double> cuts;  // ascending elevations [deg] separating consecutive beams
+  cuts.reserve(num_cuts);
+  for (std::size_t k = 0; k < num_cuts; ++k) {
+    const std::size_t i = gaps[k].second;
+    cuts.push_back(0.5 * (sorted[i - 1] + sorted[i]));
+  }
+  std::sort(cuts.begin(), cuts.end());
+
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (std::isnan(elevation[i])) {
+      cloud[i].ring = -1;
+      continue;
+    }
+    cloud[i].ring =
+        static_cast<int>(std::upper_bound(cuts.begin(), cuts.end(), elevation[i]) - cuts.begin());
+  }
+  return static_cast<int>(cuts.size()) + 1;
+}
+
+bool hasRings(const LidarCloud& cloud) {
+  return std::all_of(cloud.begin(), cloud.end(), [](const LidarPoint& p) { return p.ring >= 0; });
+}
+
+}  // namespace lidar_stereo_fusion

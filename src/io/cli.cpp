@@ -1,0 +1,61 @@
+// Command-line parsing for the tools.
+#include "lidar_stereo_fusion/io/cli.h"
+
+#include <climits>
+
+namespace lidar_stereo_fusion {
+
+CommandLine::CommandLine(int argc, const char* const* argv, const std::set<std::string>& options,
+                         const std::set<std::string>& flags) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (flags.count(arg) > 0) {
+      if (!flags_.insert(arg).second) throw UsageError(arg + " given twice");
+    } else if (options.count(arg) > 0) {
+      if (i + 1 >= argc) throw UsageError(arg + " needs a value");
+      if (values_.count(arg) > 0) throw UsageError(arg + " given twice");
+      values_[arg] = argv[++i];
+    } else {
+      throw UsageError("unknown argument '" + arg + "'");
+    }
+  }
+}
+
+bool CommandLine::has(const std::string& name) const {
+  return flags_.count(name) > 0 || values_.count(name) > 0;
+}
+
+std::string CommandLine::value(const std::string& name, const std::string& fallback) const {
+  const auto it = values_.find(name);
+  return it == values_.end() ? fallback : it->second;
+}
+
+int CommandLine::intValue(const std::string& name, int fallback, int min, int max) const {
+  const auto it = values_.find(name);
+  if (it == values_.end()) return fallback;
+  long parsed = 0;
+  size_t used = 0;
+  try {
+    parsed = std::stol(it->second, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != it->second.size() || parsed < min || parsed > max) {
+    throw UsageError(name + " must be an integer in [" + std::to_string(min) + ", " +
+                     std::to_string(max) + "], got '" + it->second + "'");
+  }
+  return static_cast<int>(parsed);
+}
+
+std::string CommandLine::choice(const std::string& name, const std::string& fallback,
+                                const std::vector<std::string>& choices) const {
+  const std::string v = value(name, fallback);
+  std::string valid;
+  for (const std::string& c : choices) {
+    if (c == v) return v;
+    valid += (valid.empty() ? "" : ", ") + c;
+  }
+  throw UsageError(name + " must be one of " + valid + ", got '" + v + "'");
+}
+
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,88 @@
+// Middlebury scenes and the row-sampled pseudo-LiDAR.
+#include "lidar_stereo_fusion/io/middlebury.h"
+
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+
+namespace lidar_stereo_fusion {
+namespace {
+
+cv::Mat readImage(const std::string& path, int flags) {
+  if (!std::filesystem::is_regular_file(path)) {
+    throw std::runtime_error("Middlebury: missing file " + path);
+  }
+  cv::Mat image = cv::imread(path, flags);
+  if (image.empty()) throw std::runtime_error("Middlebury: cannot read image " + path);
+  return image;
+}
+
+}  // namespace
+
+MiddleburyScene readMiddleburyScene(const std::string& dir, double disparity_scale) {
+  if (!(disparity_scale > 0)) {
+    throw std::invalid_argument("readMiddleburyScene: disparity_scale must be > 0");
+  }
+  const std::filesystem::path root(dir);
+  MiddleburyScene scene;
+  scene.left = readImage((root / "im2.png").string(), cv::IMREAD_COLOR);
+  scene.right = readImage((root / "im6.png").string(), cv::IMREAD_COLOR);
+  const std::string disp_path = (root / "disp2.png").string();
+  const cv::Mat raw = readImage(disp_path, cv::IMREAD_UNCHANGED);
+  if (raw.type() != CV_8UC1) {
+    throw std::runtime_error("Middlebury: " + disp_path + " is not an 8-bit grey image");
+  }
+  if (scene.left.size() != scene.right.size() || raw.size() != scene.left.size()) {
+    throw std::runtime_error("Middlebury: im2, im6 and disp2 in " + dir + " differ in size");
+  }
+  raw.convertTo(scene.disparity, CV_32F, 1.0 / disparity_scale);
+  return scene;
+}
+
+SparseDisparity sampleRowsAsScanLines(const cv::Mat1f& disparity, int num_rows) {
+  if (num_rows < 2 || num_rows > disparity.rows) {
+    throw std::invalid_argument("sampleRowsAsScanLines: num_rows must be in [2, " +
+                                std::to_string(disparity.rows) + "], got " +
+                                std::to_string(num_rows));
+  }
+  SparseDisparity sparse;
+  sparse.disparity = cv::Mat1f(disparity.size(), 0.f);
+  sparse.ring = cv::Mat1s(disparity.size(), static_cast<int16_t>(-1));
+  for (int ring = 0; ring < num_rows; ++ring) {
+    const int y = static_cast<int>(std::floor((ring + 0.5) * disparity.rows / num_rows));
+    for (int x = 0; x < disparity.cols; ++x) {
+      const float d = disparity(y, x);
+      if (!(std::isfinite(d) && d > 0.f)) continue;
+      sparse.disparity(y, x) = d;
+      sparse.ring(y, x) = static_cast<int16_t>(ring);
+      ++sparse.points_in_image;
+    }
+  }
+  sparse.points_in_front = sparse.points_in_image;
+  return sparse;
+}
+
+SparseDisparity shiftToRightView(const SparseDisparity& left) {
+  SparseDisparity right;
+  right.disparity = cv::Mat1f(left.disparity.size(), 0.f);
+  right.ring = cv::Mat1s(left.disparity.size(), static_cast<int16_t>(-1));
+  right.points_in_front = left.points_in_front;
+  for (int y = 0; y < left.disparity.rows; ++y) {
+    for (int x = 0; x < left.disparity.cols; ++x) {
+      const float d = left.disparity(y, x);
+      if (!(std::isfinite(d) && d > 0.f)) continue;
+      const int xr = static_cast<int>(std::floor(x - d + 0.5));
+      if (xr < 0 || xr >= left.disparity.cols) continue;
+      ++right.points_in_image;
+      if (d > right.disparity(y, xr)) {
+        right.disparity(y, xr) = d;
+        right.ring(y, xr) = left.ring.empty() ? static_cast<int16_t>(-1) : left.ring(y, x);
+      }
+    }
+  }
+  return right;
+}
+
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,302 @@
+// PCD reader/writer (ascii and binary) without PCL.
+#include "lidar_stereo_fusion/io/pcd.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "lidar_stereo_fusion/core/lidar_projection.h"
+
+namespace lidar_stereo_fusion {
+namespace pcd {
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw std::runtime_error("PCD " + path + ": " + what);
+}
+
+std::vector<std::string> splitWords(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<std::string> words;
+  std::string word;
+  while (in >> word) words.push_back(word);
+  return words;
+}
+
+long long parseInteger(const std::string& path, const std::string& key, const std::string& text) {
+  char* end = nullptr;
+  const long long value = std::strtoll(text.c_str(), &end, 10);
+  if (end == text.c_str() || *end != '\0') {
+    fail(path, "header " + key + " has a non-integer value '" + text + "'");
+  }
+  return value;
+}
+
+/// Parses header lines up to and including DATA; leaves `in` at the first data byte.
+Header readHeader(std::istream& in, const std::string& path) {
+  Header header;
+  bool have_points = false;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::vector<std::string> words = splitWords(line);
+    if (words.empty() || words[0][0] == '#') continue;
+    const std::string& key = words[0];
+    const std::vector<std::string> values(words.begin() + 1, words.end());
+    if (key == "VERSION") {
+      header.version = values.empty() ? "" : values[0];
+    } else if (key == "FIELDS" || key == "COLUMNS") {
+      header.fields = values;
+    } else if (key == "SIZE") {
+      for (const auto& v : values)
+        header.sizes.push_back(static_cast<int>(parseInteger(path, key, v)));
+    } else if (key == "TYPE") {
+      for (const auto& v : values) {
+        if (v.size() != 1 || (v[0] != 'F' && v[0] != 'I' && v[0] != 'U')) {
+          fail(path, "header TYPE '" + v + "' is not F, I or U");
+        }
+        header.types.push_back(v[0]);
+      }
+    } else if (key == "COUNT") {
+      for (const auto& v : values)
+        header.counts.push_back(static_cast<int>(parseInteger(path, key, v)));
+    } else if (key == "WIDTH" && values.size() == 1) {
+      header.width = static_cast<int>(parseInteger(path, key, values[0]));
+    } else if (key == "HEIGHT" && values.size() == 1) {
+      header.height = static_cast<int>(parseInteger(path, key, values[0]));
+    } else if (key == "POINTS" && values.size() == 1) {
+      const long long points = parseInteger(path, key, values[0]);
+      if (points < 0) fail(path, "header POINTS is negative");
+      header.points = static_cast<std::size_t>(points);
+      have_points = true;
+    } else if (key == "DATA") {
+      header.data = values.empty() ? "" : values[0];
+      break;
+    }  // VIEWPOINT and unknown keys are ignored
+  }
+  if (header.data.empty()) fail(path, "no DATA line (not a PCD file, or truncated header)");
+  if (header.fields.empty()) fail(path, "header has no FIELDS");
+  const std::size_t n = header.fields.size();
+  if (header.counts.empty()) header.counts.assign(n, 1);
+  if (header.sizes.size() != n || header.types.size() != n || header.counts.size() != n) {
+    fail(path, "header FIELDS, SIZE, TYPE and COUNT have different lengths");
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const int size = header.sizes[i];
+    const bool ok = header.types[i] == 'F' ? (size == 4 || size == 8)
+                                           : (size == 1 || size == 2 || size == 4 || size == 8);
+    if (!ok) {
+      fail(path, "field '" + header.fields[i] + "' has unsupported TYPE " +
+                     std::string(1, header.types[i]) + " with SIZE " + std::to_string(size));
+    }
+    if (header.counts[i] < 1) fail(path, "field '" + header.fields[i] + "' has COUNT < 1");
+  }
+  if (header.width < 0 || header.height < 0) fail(path, "header WIDTH/HEIGHT is negative");
+  if (header.height == 0) header.height = 1;
+  const std::size_t grid = static_cast<std::size_t>(header.width) * header.height;
+  if (!have_points) header.points = grid;
+  if (header.points != grid) {
+    fail(path, "header POINTS (" + std::to_string(header.points) + ") != WIDTH * HEIGHT (" +
+                   std::to_string(grid) + ")");
+  }
+  return header;
+}
+
+/// Where the fields we use sit within one point.
+struct Layout {
+  int x = -1, y = -1, z = -1, intensity = -1, ring = -1, time = -1;  ///< field index or -1
+  std::vector<std::size_t> offset;  ///< byte offset of each field in a binary record
+  std::vector<std::size_t> column;  ///< token index of each field in an ascii line
+  std::size_t stride = 0;           ///< bytes per binary record
+  std::size_t tokens = 0;           ///< numbers per ascii line
+};
+
+Layout makeLayout(const Header& header, const std::string& path) {
+  Layout layout;
+  for (std::size_t i = 0; i < header.fields.size(); ++i) {
+    const std::string& name = header.fields[i];
+    const int index = static_cast<int>(i);
+    if (name == "x") layout.x = index;
+    if (name == "y") layout.y = index;
+    if (name == "z") layout.z = index;
+    if (name == "intensity") layout.intensity = index;
+    if (name == "ring") layout.ring = index;
+    if (name == "time") layout.time = index;
+    layout.offset.push_back(layout.stride);
+    layout.column.push_back(layout.tokens);
+    layout.stride += static_cast<std::size_t>(header.sizes[i]) * header.counts[i];
+    layout.tokens += header.counts[i];
+  }
+  if (layout.x < 0 || layout.y < 0 || layout.z < 0) fail(path, "fields x, y and z are required");
+  return layout;
+}
+
+template <typename T>
+double load(const unsigned char* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  return static_cast<double>(value);
+}
+
+double decodeBinary(const unsigned char* p, char type, int size) {
+  if (type == 'F') return size == 4 ? load<float>(p) : load<double>(p);
+  if (type == 'I') {
+    switch (size) {
+      case 1:
+        return load<int8_t>(p);
+      case 2:
+        return load<int16_t>(p);
+      case 4:
+        return load<int32_t>(p);
+      default:
+        return load<int64_t>(p);
+    }
+  }
+  switch (size) {
+    case 1:
+      return load<uint8_t>(p);
+    case 2:
+      return load<uint16_t>(p);
+    case 4:
+      return load<uint32_t>(p);
+    default:
+      return load<uint64_t>(p);
+  }
+}
+
+/// Fills one point from a getter value(field index) -> double.
+template <typename Getter>
+LidarPoint makePoint(const Layout& layout, Getter value) {
+  LidarPoint point;
+  point.x = static_cast<float>(value(layout.x));
+  point.y = static_cast<float>(value(layout.y));
+  point.z = static_cast<float>(value(layout.z));
+  if (layout.intensity >= 0) point.intensity = static_cast<float>(value(layout.intensity));
+  if (layout.ring >= 0) {
+    const double ring = value(layout.ring);
+    point.ring = std::isfinite(ring) && ring >= 0.0 && ring <= std::numeric_limits<int>::max()
+                     ? static_cast<int>(std::lround(ring))
+                     : -1;
+  }
+  if (layout.time >= 0) point.time = static_cast<float>(value(layout.time));
+  return point;
+}
+
+LidarCloud readBinary(std::istream& in, const Header& header, const Layout& layout,
+                      const std::string& path) {
+  std::vector<unsigned char> bytes(header.points * layout.stride);
+  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  if (static_cast<std::size_t>(in.gcount()) != bytes.size()) {
+    fail(path, "binary data is truncated: expected " + std::to_string(bytes.size()) +
+                   " bytes for " + std::to_string(header.points) + " points, got " +
+                   std::to_string(in.gcount()));
+  }
+  LidarCloud cloud;
+  cloud.reserve(header.points);
+  for (std::size_t i = 0; i < header.points; ++i) {
+    const unsigned char* record = bytes.data() + i * layout.stride;
+    cloud.push_back(makePoint(layout, [&](int f) {
+      return decodeBinary(record + layout.offset[f], header.types[f], header.sizes[f]);
+    }));
+  }
+  return cloud;
+}
+
+LidarCloud readAscii(std::istream& in, const Header& header, const Layout& layout,
+                     const std::string& path) {
+  LidarCloud cloud;
+  cloud.reserve(header.points);
+  std::vector<double> numbers(layout.tokens);
+  std::string line;
+  while (cloud.size() < header.points && std::getline(in, line)) {
+    const std::vector<std::string> words = splitWords(line);
+    if (words.empty()) continue;
+    if (words.size() != layout.tokens) {
+      fail(path, "ascii point " + std::to_string(cloud.size()) + " has " +
+                     std::to_string(words.size()) + " values, the header says " +
+                     std::to_string(layout.tokens));
+    }
+    for (std::size_t k = 0; k < words.size(); ++k) {
+      char* end = nullptr;
+      numbers[k] = std::strtod(words[k].c_str(), &end);
+      if (end == words[k].c_str() || *end != '\0') {
+        fail(path, "ascii point " + std::to_string(cloud.size()) + " has a non-number '" +
+                       words[k] + "'");
+      }
+    }
+    cloud.push_back(makePoint(layout, [&](int f) { return numbers[layout.column[f]]; }));
+  }
+  if (cloud.size() != header.points) {
+    fail(path, "ascii data is truncated: " + std::to_string(cloud.size()) + " of " +
+                   std::to_string(header.points) + " points");
+  }
+  return cloud;
+}
+
+}  // namespace
+
+bool Header::hasField(const std::string& name) const {
+  return std::find(fields.begin(), fields.end(), name) != fields.end();
+}
+
+LidarCloud readPcd(const std::string& path, Header* header_out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, "cannot open file");
+  const Header header = readHeader(in, path);
+  const Layout layout = makeLayout(header, path);
+  if (header_out) *header_out = header;
+  if (header.data == "binary") return readBinary(in, header, layout, path);
+  if (header.data == "ascii") return readAscii(in, header, layout, path);
+  if (header.data == "binary_compressed") {
+    fail(path,
+         "DATA binary_compressed is not supported; convert with pcl_convert_pcd_ascii_binary "
+         "<in> <out> 1 (binary)");
+  }
+  fail(path, "unknown DATA '" + header.data + "' (expected ascii or binary)");
+}
+
+void writePcd(const std::string& path, const LidarCloud& cloud, bool binary) {
+  const bool with_ring = !cloud.empty() && hasRings(cloud);
+  for (const LidarPoint& p : cloud) {
+    if (with_ring && p.ring > std::numeric_limits<uint16_t>::max()) {
+      fail(path, "ring " + std::to_string(p.ring) + " does not fit uint16");
+    }
+  }
+  std::ofstream out(path, std::ios::binary);
+  if (!out) fail(path, "cannot open file for writing");
+  out << "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n";
+  out << (with_ring ? "FIELDS x y z intensity ring time\nSIZE 4 4 4 4 2 4\nTYPE F F F F U F\n"
+                      "COUNT 1 1 1 1 1 1\n"
+                    : "FIELDS x y z intensity time\nSIZE 4 4 4 4 4\nTYPE F F F F F\n"
+                      "COUNT 1 1 1 1 1\n");
+  out << "WIDTH " << cloud.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << cloud.size()
+      << "\nDATA " << (binary ? "binary" : "ascii") << "\n";
+  if (binary) {
+    for (const LidarPoint& p : cloud) {
+      const float xyzi[4] = {p.x, p.y, p.z, p.intensity};
+      out.write(reinterpret_cast<const char*>(xyzi), sizeof(xyzi));
+      if (with_ring) {
+        const uint16_t ring = static_cast<uint16_t>(p.ring);
+        out.write(reinterpret_cast<const char*>(&ring), sizeof(ring));
+      }
+      out.write(reinterpret_cast<const char*>(&p.time), sizeof(p.time));
+    }
+  } else {
+    out.precision(std::numeric_limits<float>::max_digits10);
+    for (const LidarPoint& p : cloud) {
+      out << p.x << ' ' << p.y << ' ' << p.z << ' ' << p.intensity;
+      if (with_ring) out << ' ' << p.ring;
+      out << ' ' << p.time << '\n';
+    }
+  }
+  if (!out) fail(path, "write failed");
+}
+
+}  // namespace pcd
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,121 @@
+// Colourised disparity / depth / error maps (OpenCV's perceptual TURBO colour map).
+#include "lidar_stereo_fusion/io/visualization.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+namespace lidar_stereo_fusion {
+namespace {
+
+bool hasValue(float v) { return std::isfinite(v) && v > 0.f; }
+
+/// Largest valid value of `m` (0 when there is none).
+double maxValue(const cv::Mat1f& m) {
+  double best = 0.0;
+  for (int y = 0; y < m.rows; ++y) {
+    for (int x = 0; x < m.cols; ++x) {
+      if (hasValue(m(y, x))) best = std::max(best, static_cast<double>(m(y, x)));
+    }
+  }
+  return best;
+}
+
+/// Maps `level` (0..255) through TURBO; pixels where `mask` is 0 become black.
+cv::Mat colorize(const cv::Mat1b& level, const cv::Mat1b& mask) {
+  cv::Mat color;
+  cv::applyColorMap(level, color, cv::COLORMAP_TURBO);
+  color.setTo(cv::Scalar::all(0), mask == 0);
+  return color;
+}
+
+uint8_t toLevel(double fraction) {
+  return static_cast<uint8_t>(std::lround(255.0 * std::clamp(fraction, 0.0, 1.0)));
+}
+
+void requireNonEmpty(const cv::Mat& m, const char* who) {
+  if (m.empty()) throw std::invalid_argument(std::string(who) + ": empty input");
+}
+
+}  // namespace
+
+cv::Mat colorizeDisparity(const cv::Mat1f& disparity, double max_disparity) {
+  requireNonEmpty(disparity, "colorizeDisparity");
+  const double scale = max_disparity > 0 ? max_disparity : maxValue(disparity);
+  cv::Mat1b level(disparity.size(), uint8_t{0}), mask(disparity.size(), uint8_t{0});
+  for (int y = 0; y < disparity.rows; ++y) {
+    for (int x = 0; x < disparity.cols; ++x) {
+      const float d = disparity(y, x);
+      if (!hasValue(d)) continue;
+      mask(y, x) = 255;
+      level(y, x) = toLevel(scale > 0 ? d / scale : 0.0);
+    }
+  }
+  return colorize(level, mask);
+}
+
+cv::Mat colorizeDepth(const cv::Mat1f& depth, double max_depth) {
+  requireNonEmpty(depth, "colorizeDepth");
+  if (!(max_depth > 0)) throw std::invalid_argument("colorizeDepth: max_depth must be > 0 [m]");
+  cv::Mat1b level(depth.size(), uint8_t{0}), mask(depth.size(), uint8_t{0});
+  for (int y = 0; y < depth.rows; ++y) {
+    for (int x = 0; x < depth.cols; ++x) {
+      const float z = depth(y, x);
+      if (!hasValue(z)) continue;
+      mask(y, x) = 255;
+      level(y, x) = toLevel(1.0 - z / max_depth);  // near = warm (high end of TURBO)
+    }
+  }
+  return colorize(level, mask);
+}
+
+cv::Mat colorizeError(const cv::Mat1f& estimate, const cv::Mat1f& reference, double max_error) {
+  requireNonEmpty(reference, "colorizeError");
+  if (estimate.size() != reference.size()) {
+    throw std::invalid_argument("colorizeError: estimate and reference differ in size");
+  }
+  if (!(max_error > 0)) throw std::invalid_argument("colorizeError: max_error must be > 0");
+  cv::Mat1b level(reference.size(), uint8_t{0}), mask(reference.size(), uint8_t{0});
+  for (int y = 0; y < reference.rows; ++y) {
+    for (int x = 0; x < reference.cols; ++x) {
+      const float ref = reference(y, x);
+      if (!hasValue(ref)) continue;
+      const float est = estimate(y, x);
+      const double err = hasValue(est) ? std::abs(est - ref) : max_error;  // missing: worst
+      mask(y, x) = 255;
+      level(y, x) = toLevel(err / max_error);
+    }
+  }
+  return colorize(level, mask);
+}
+
+cv::Mat overlaySparse(const cv::Mat& image, const cv::Mat1f& sparse, double max_disparity) {
+  requireNonEmpty(image, "overlaySparse");
+  if (image.size() != sparse.size()) {
+    throw std::invalid_argument("overlaySparse: image and sparse disparity differ in size");
+  }
+  if (image.type() != CV_8UC3 && image.type() != CV_8UC1) {
+    throw std::invalid_argument("overlaySparse: image must be BGR CV_8UC3 or grey CV_8UC1");
+  }
+  cv::Mat canvas;
+  if (image.channels() == 1) {
+    cv::cvtColor(image, canvas, cv::COLOR_GRAY2BGR);
+  } else {
+    canvas = image.clone();
+  }
+  canvas.convertTo(canvas, -1, 0.4);  // darken so the dots stand out
+  const cv::Mat colors = colorizeDisparity(sparse, max_disparity);
+  for (int y = 0; y < sparse.rows; ++y) {
+    for (int x = 0; x < sparse.cols; ++x) {
+      if (!hasValue(sparse(y, x))) continue;
+      const cv::Vec3b c = colors.at<cv::Vec3b>(y, x);
+      cv::circle(canvas, cv::Point(x, y), 1, cv::Scalar(c[0], c[1], c[2]), cv::FILLED);
+    }
+  }
+  return canvas;
+}
+
+}  // namespace lidar_stereo_fusion

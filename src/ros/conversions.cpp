@@ -1,0 +1,437 @@
+#include "lidar_stereo_fusion/ros/conversions.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <sstream>
+
+#include <boost/make_shared.hpp>
+#include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgproc.hpp>
+#include <sensor_msgs/image_encodings.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+namespace lidar_stereo_fusion {
+namespace conversions {
+
+namespace enc = sensor_msgs::image_encodings;
+
+const std::vector<std::string>& supportedImageEncodings() {
+  static const std::vector<std::string> kEncodings = {enc::BGRA8, enc::RGBA8, enc::BGR8, enc::RGB8,
+                                                      enc::MONO8};
+  return kEncodings;
+}
+
+namespace {
+
+std::string joined(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+bool isSupported(const std::string& encoding) {
+  const auto& all = supportedImageEncodings();
+  return std::find(all.begin(), all.end(), encoding) != all.end();
+}
+
+}  // namespace
+
+std::string checkImage(const sensor_msgs::Image& msg) {
+  std::ostringstream problem;
+  if (!isSupported(msg.encoding)) {
+    problem << "unsupported encoding '" << msg.encoding << "' (supported: "
+            << joined(supportedImageEncodings()) << ")";
+  } else if (msg.width == 0 || msg.height == 0) {
+    problem << "empty image (" << msg.width << "x" << msg.height << ")";
+  } else if (msg.step < msg.width * static_cast<uint32_t>(enc::numChannels(msg.encoding))) {
+    problem << "step " << msg.step << " is smaller than width * channels for " << msg.encoding;
+  } else if (msg.data.size() < static_cast<size_t>(msg.step) * msg.height) {
+    problem << "data has " << msg.data.size() << " bytes, step * height needs "
+            << static_cast<size_t>(msg.step) * msg.height;
+  }
+  return problem.str();
+}
+
+cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg) {
+  const std::string problem = checkImage(*msg);
+  if (!problem.empty()) throw ConversionError(problem);
+  cv_bridge::CvImageConstPtr shared;
+  try {
+    shared = cv_bridge::toCvShare(msg);
+  } catch (const cv_bridge::Exception& e) {
+    throw ConversionError(std::string("cv_bridge: ") + e.what());
+  }
+  const std::string& e = msg->encoding;
+  cv::Mat out;
+  if (e == enc::BGR8 || e == enc::MONO8) {
+    out = shared->image;  // shares the message's memory (documented in the header)
+  } else if (e == enc::BGRA8) {
+    cv::cvtColor(shared->image, out, cv::COLOR_BGRA2BGR);
+  } else if (e == enc::RGBA8) {
+    cv::cvtColor(shared->image, out, cv::COLOR_RGBA2BGR);
+  } else {  // rgb8
+    cv::cvtColor(shared->image, out, cv::COLOR_RGB2BGR);
+  }
+  return out;
+}
+
+void stereoPairToCore(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right,
+                      cv::Mat& left_out, cv::Mat& right_out) {
+  if (left->width != right->width || left->height != right->height) {
+    std::ostringstream s;
+    s << "left image is " << left->width << "x" << left->height << " but right image is "
+      << right->width << "x" << right->height << " (the pair must be rectified to one size)";
+    throw ConversionError(s.str());
+  }
+  left_out = imageToCore(left);
+  right_out = imageToCore(right);
+  if (left_out.type() != right_out.type()) {  // one mono8, one colour: both to BGR
+    if (left_out.channels() == 1) cv::cvtColor(left_out, left_out, cv::COLOR_GRAY2BGR);
+    if (right_out.channels() == 1) cv::cvtColor(right_out, right_out, cv::COLOR_GRAY2BGR);
+  }
+}
+
+StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
+                                  const sensor_msgs::CameraInfo& right) {
+  const auto& Pl = left.P;
+  const auto& Pr = right.P;
+  if (Pl[0] <= 0.0 || Pl[5] <= 0.0) {
+    throw ConversionError("left camera_info: P has no focal length (fx = " + std::to_string(Pl[0]) +
+                          ", fy = " + std::to_string(Pl[5]) + "); is the camera calibrated?");
+  }
+  if (Pr[0] <= 0.0) {
+    throw ConversionError("right camera_info: P has no focal length (fx = " +
+                          std::to_string(Pr[0]) + "); is the camera calibrated?");
+  }
+  if (std::abs(Pl[0] - Pr[0]) > 1e-3 * Pl[0] || std::abs(Pl[5] - Pr[5]) > 1e-3 * Pl[5]) {
+    throw ConversionError("left and right camera_info P differ in focal length (fx " +
+                          std::to_string(Pl[0]) + " vs " + std::to_string(Pr[0]) +
+                          "): images are not rectified to a common camera");
+  }
+  if (left.width != right.width || left.height != right.height) {
+    throw ConversionError("left camera_info is " + std::to_string(left.width) + "x" +
+                          std::to_string(left.height) + " but right camera_info is " +
+                          std::to_string(right.width) + "x" + std::to_string(right.height));
+  }
+  StereoCamera camera;
+  camera.fx = Pl[0];
+  camera.fy = Pl[5];
+  camera.cx = Pl[2];
+  camera.cy = Pl[6];
+  // Tx = P[3] = -fx * B for the right camera in the ROS convention (left Tx = 0); some drivers
+  // write +fx * B. The difference of the two Tx is independent of the reference camera.
+  camera.baseline = std::abs(Pr[3] - Pl[3]) / Pl[0];
+  camera.width = static_cast<int>(left.width);
+  camera.height = static_cast<int>(left.height);
+  if (!(camera.baseline > 0.0) || !std::isfinite(camera.baseline)) {
+    throw ConversionError("right camera_info: P[3] (Tx = -fx * baseline) is " +
+                          std::to_string(Pr[3]) +
+                          ", equal to the left one: no baseline (is this the right camera's info?)");
+  }
+  return camera;
+}
+
+// -------------------------------------------------------------------------------------------------
+// PointCloud2 input
+// -------------------------------------------------------------------------------------------------
+namespace {
+
+using sensor_msgs::PointField;
+
+int datatypeSize(uint8_t datatype) {
+  switch (datatype) {
+    case PointField::INT8:
+    case PointField::UINT8:
+      return 1;
+    case PointField::INT16:
+    case PointField::UINT16:
+      return 2;
+    case PointField::INT32:
+    case PointField::UINT32:
+    case PointField::FLOAT32:
+      return 4;
+    case PointField::FLOAT64:
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+template <typename T>
+double readAs(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));  // unaligned-safe
+  return static_cast<double>(v);
+}
+
+/// Reads one numeric field of any PointField datatype as double.
+double readField(const uint8_t* p, uint8_t datatype) {
+  switch (datatype) {
+    case PointField::INT8:
+      return readAs<int8_t>(p);
+    case PointField::UINT8:
+      return readAs<uint8_t>(p);
+    case PointField::INT16:
+      return readAs<int16_t>(p);
+    case PointField::UINT16:
+      return readAs<uint16_t>(p);
+    case PointField::INT32:
+      return readAs<int32_t>(p);
+    case PointField::UINT32:
+      return readAs<uint32_t>(p);
+    case PointField::FLOAT32:
+      return readAs<float>(p);
+    case PointField::FLOAT64:
+      return readAs<double>(p);
+    default:
+      return std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+struct FieldRef {
+  bool present = false;
+  uint32_t offset = 0;
+  uint8_t datatype = 0;
+};
+
+FieldRef findField(const sensor_msgs::PointCloud2& msg, const std::string& name) {
+  FieldRef ref;
+  for (const auto& f : msg.fields) {
+    if (f.name == name) {
+      ref.present = true;
+      ref.offset = f.offset;
+      ref.datatype = f.datatype;
+      break;
+    }
+  }
+  return ref;
+}
+
+bool hostIsBigEndian() {
+  const uint16_t one = 1;
+  uint8_t first;
+  std::memcpy(&first, &one, 1);
+  return first == 0;
+}
+
+}  // namespace
+
+std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg) {
+  std::ostringstream problem;
+  if (msg.is_bigendian != hostIsBigEndian()) {
+    problem << "byte order of the cloud differs from the host's (is_bigendian = "
+            << static_cast<int>(msg.is_bigendian) << ")";
+    return problem.str();
+  }
+  for (const char* name : {"x", "y", "z"}) {
+    if (!findField(msg, name).present) {
+      problem << "no '" << name << "' field (fields:";
+      for (const auto& f : msg.fields) problem << " " << f.name;
+      problem << ")";
+      return problem.str();
+    }
+  }
+  for (const auto& f : msg.fields) {
+    const int size = datatypeSize(f.datatype);
+    if (size == 0) {
+      if (f.name == "x" || f.name == "y" || f.name == "z" || f.name == "intensity" ||
+          f.name == "ring" || f.name == "time") {
+        problem << "field '" << f.name << "' has unknown datatype " << static_cast<int>(f.datatype);
+        return problem.str();
+      }
+      continue;
+    }
+    if (f.offset + static_cast<uint32_t>(size) > msg.point_step) {
+      problem << "field '" << f.name << "' (offset " << f.offset << ", " << size
+              << " bytes) does not fit in point_step " << msg.point_step;
+      return problem.str();
+    }
+  }
+  const size_t points = static_cast<size_t>(msg.width) * msg.height;
+  if (points > 0 && static_cast<size_t>(msg.point_step) * msg.width > msg.row_step) {
+    problem << "row_step " << msg.row_step << " < point_step * width";
+    return problem.str();
+  }
+  if (points > 0 && msg.data.size() < static_cast<size_t>(msg.row_step) * msg.height) {
+    problem << "data has " << msg.data.size() << " bytes, row_step * height needs "
+            << static_cast<size_t>(msg.row_step) * msg.height;
+    return problem.str();
+  }
+  return {};
+}
+
+CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg) {
+  const std::string problem = checkCloudLayout(msg);
+  if (!problem.empty()) throw ConversionError(problem);
+  const FieldRef fx = findField(msg, "x"), fy = findField(msg, "y"), fz = findField(msg, "z");
+  const FieldRef fi = findField(msg, "intensity"), fr = findField(msg, "ring"),
+                 ft = findField(msg, "time");
+  CloudConversion out;
+  out.has_ring = fr.present;
+  out.has_time = ft.present;
+  out.total_points = static_cast<int>(msg.width * msg.height);
+  out.cloud.reserve(out.total_points);
+  for (uint32_t row = 0; row < msg.height; ++row) {
+    const uint8_t* row_ptr = msg.data.data() + static_cast<size_t>(row) * msg.row_step;
+    for (uint32_t col = 0; col < msg.width; ++col) {
+      const uint8_t* p = row_ptr + static_cast<size_t>(col) * msg.point_step;
+      LidarPoint point;
+      point.x = static_cast<float>(readField(p + fx.offset, fx.datatype));
+      point.y = static_cast<float>(readField(p + fy.offset, fy.datatype));
+      point.z = static_cast<float>(readField(p + fz.offset, fz.datatype));
+      if (!std::isfinite(point.x) || !std::isfinite(point.y) || !std::isfinite(point.z)) {
+        ++out.non_finite;
+        continue;
+      }
+      if (fi.present) point.intensity = static_cast<float>(readField(p + fi.offset, fi.datatype));
+      if (fr.present) {
+        const double ring = readField(p + fr.offset, fr.datatype);
+        point.ring = std::isfinite(ring) && ring >= 0.0 && ring < 65536.0 ? static_cast<int>(ring)
+                                                                          : -1;
+      }
+      if (ft.present) {
+        const double t = readField(p + ft.offset, ft.datatype);
+        point.time = std::isfinite(t) ? static_cast<float>(t) : 0.f;
+      }
+      out.cloud.push_back(point);
+    }
+  }
+  return out;
+}
+
+sensor_msgs::PointCloud2 cloudToMsg(const LidarCloud& cloud, const std_msgs::Header& header) {
+  sensor_msgs::PointCloud2 msg;
+  msg.header = header;
+  sensor_msgs::PointCloud2Modifier modifier(msg);
+  modifier.setPointCloud2Fields(6, "x", 1, PointField::FLOAT32, "y", 1, PointField::FLOAT32, "z", 1,
+                                PointField::FLOAT32, "intensity", 1, PointField::FLOAT32, "ring", 1,
+                                PointField::UINT16, "time", 1, PointField::FLOAT32);
+  modifier.resize(cloud.size());
+  sensor_msgs::PointCloud2Iterator<float> x(msg, "x"), y(msg, "y"), z(msg, "z"),
+      intensity(msg, "intensity"), time(msg, "time");
+  sensor_msgs::PointCloud2Iterator<uint16_t> ring(msg, "ring");
+  for (const auto& p : cloud) {
+    *x = p.x;
+    *y = p.y;
+    *z = p.z;
+    *intensity = p.intensity;
+    *ring = static_cast<uint16_t>(std::max(p.ring, 0));
+    *time = p.time;
+    ++x, ++y, ++z, ++intensity, ++ring, ++time;
+  }
+  msg.is_dense = false;
+  return msg;
+}
+
+// -------------------------------------------------------------------------------------------------
+// Outputs
+// -------------------------------------------------------------------------------------------------
+namespace {
+
+sensor_msgs::Image floatImage(const cv::Mat1f& image, const std_msgs::Header& header) {
+  sensor_msgs::Image msg;
+  msg.header = header;
+  msg.height = static_cast<uint32_t>(image.rows);
+  msg.width = static_cast<uint32_t>(image.cols);
+  msg.encoding = enc::TYPE_32FC1;
+  msg.is_bigendian = hostIsBigEndian();
+  msg.step = msg.width * sizeof(float);
+  msg.data.resize(static_cast<size_t>(msg.step) * msg.height);
+  for (int r = 0; r < image.rows; ++r) {
+    std::memcpy(msg.data.data() + static_cast<size_t>(r) * msg.step, image.ptr<float>(r), msg.step);
+  }
+  return msg;
+}
+
+}  // namespace
+
+stereo_msgs::DisparityImagePtr disparityToMsg(const cv::Mat1f& disparity,
+                                              const std_msgs::Header& header,
+                                              const StereoCamera& camera, double min_search,
+                                              double max_search) {
+  auto msg = boost::make_shared<stereo_msgs::DisparityImage>();
+  msg->header = header;
+  msg->image = floatImage(disparity, header);
+  msg->f = static_cast<float>(camera.fx);
+  msg->T = static_cast<float>(camera.baseline);
+  // Valid values are > 0; the range is the search range widened to what the map holds, so that
+  // every valid value is within [min_disparity, max_disparity] and 0 (no value) is below it.
+  double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
+  int left = disparity.cols, top = disparity.rows, right = -1, bottom = -1;
+  for (int r = 0; r < disparity.rows; ++r) {
+    const float* row = disparity.ptr<float>(r);
+    for (int c = 0; c < disparity.cols; ++c) {
+      const float d = row[c];
+      if (!(d > 0.f) || !std::isfinite(d)) continue;
+      lo = std::min(lo, static_cast<double>(d));
+      hi = std::max(hi, static_cast<double>(d));
+      left = std::min(left, c);
+      right = std::max(right, c);
+      top = std::min(top, r);
+      bottom = std::max(bottom, r);
+    }
+  }
+  double min_d = min_search > 0.0 ? min_search : 1.0;
+  double max_d = std::max(max_search, min_d);
+  if (right >= 0) {
+    min_d = std::min(min_d, lo);
+    max_d = std::max(max_d, hi);
+    msg->valid_window.x_offset = static_cast<uint32_t>(left);
+    msg->valid_window.y_offset = static_cast<uint32_t>(top);
+    msg->valid_window.width = static_cast<uint32_t>(right - left + 1);
+    msg->valid_window.height = static_cast<uint32_t>(bottom - top + 1);
+  }
+  msg->min_disparity = static_cast<float>(min_d);
+  msg->max_disparity = static_cast<float>(max_d);
+  // PatchMatch planes give continuous disparities; 1/16 px is the nominal step stereo_image_proc
+  // publishes and below the accuracy of the refinement (which stops at 0.1 px).
+  msg->delta_d = 1.f / 16.f;
+  return msg;
+}
+
+sensor_msgs::ImagePtr depthToMsg(const cv::Mat1f& depth, const std_msgs::Header& header,
+                                 double max_depth) {
+  auto msg = boost::make_shared<sensor_msgs::Image>(floatImage(depth, header));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float limit = max_depth > 0.0 ? static_cast<float>(max_depth)
+                                      : std::numeric_limits<float>::infinity();
+  float* data = reinterpret_cast<float*>(msg->data.data());
+  const size_t n = static_cast<size_t>(depth.rows) * depth.cols;
+  for (size_t i = 0; i < n; ++i) {
+    if (!(data[i] > 0.f) || !(data[i] <= limit)) data[i] = nan;
+  }
+  return msg;
+}
+
+sensor_msgs::ImagePtr floatImageToMsg(const cv::Mat1f& image, const std_msgs::Header& header) {
+  return boost::make_shared<sensor_msgs::Image>(floatImage(image, header));
+}
+
+sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const std::vector<ColoredPoint>& points,
+                                              const std_msgs::Header& header) {
+  auto msg = boost::make_shared<sensor_msgs::PointCloud2>();
+  msg->header = header;
+  sensor_msgs::PointCloud2Modifier modifier(*msg);
+  modifier.setPointCloud2Fields(4, "x", 1, PointField::FLOAT32, "y", 1, PointField::FLOAT32, "z", 1,
+                                PointField::FLOAT32, "rgb", 1, PointField::FLOAT32);
+  modifier.resize(points.size());
+  sensor_msgs::PointCloud2Iterator<float> x(*msg, "x"), y(*msg, "y"), z(*msg, "z");
+  sensor_msgs::PointCloud2Iterator<uint8_t> rgb(*msg, "rgb");  // bytes b, g, r, a (little endian)
+  for (const auto& p : points) {
+    *x = p.x;
+    *y = p.y;
+    *z = p.z;
+    rgb[0] = p.b;
+    rgb[1] = p.g;
+    rgb[2] = p.r;
+    rgb[3] = 0;
+    ++x, ++y, ++z, ++rgb;
+  }
+  msg->is_dense = true;
+  return msg;
+}
+
+}  // namespace conversions
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,456 @@
+// kitti_to_bag: converts a KITTI raw drive (synced + rectified) into a ROS 1 bag with the topics
+// of the stereo + LiDAR rig, so that the fusion nodelet can be replayed on real data.
+//
+//   kitti_to_bag --kitti-raw <date>/<drive>_sync --out <file.bag> [--frames N]
+//                [--calib-dir <date>] [--compression none|lz4|bz2]
+//
+// Topics (message time = header stamp):
+//   /stereo/left/image_rect_color    sensor_msgs/Image bgr8, frame left_camera_optical_frame
+//   /stereo/left/camera_info         rectified: D = 0, R = I, P = [K | 0]
+//   /stereo/right/image_rect_color   sensor_msgs/Image bgr8, frame right_camera_optical_frame
+//   /stereo/right/camera_info        P = [K | (-fx * B, 0, 0)^T]
+//   /velodyne_points                 sensor_msgs/PointCloud2, frame velodyne: x, y, z, intensity
+//                                    float32 [m, m, m, reflectance], ring uint16, time float32 [s]
+//   /tf_static                       velodyne -> left_camera_optical_frame (T_cam_velo^-1) and
+//                                    left -> right optical frame (+B along x); latched on replay
+//
+// Stamps come from the KITTI timestamp files. Both images of a pair (and both camera infos) take
+// the image_02 stamp: the pair is hardware-triggered and rectified together, the image_03 stamps
+// differ by < 1 ms, and a stereo consumer needs one stamp per pair. The cloud is stamped at the
+// end of its sweep (velodyne_points/timestamps_end.txt), as velodyne_driver stamps a scan at its
+// last packet: about 40 ms after the images here (near, not equal). Without timestamps_end.txt
+// it takes timestamps.txt, the instant the scanner faced forward and triggered the cameras.
+// Per-point `time` is the offset [s] from the cloud stamp, from the point's azimuth: the HDL-64E
+// spins clockwise seen from above and a KITTI sweep runs from the rear (timestamps_start.txt)
+// through the front (timestamps.txt) to the rear again (timestamps_end.txt), so
+// time = (pi - atan2(y, x)) / (2 pi) * (end - start) - (stamp - start), in [-(end - start), 0].
+// Rings are recovered from the sweep storage order (recoverRingsBySweepOrder).
+//
+// Only frames with image_02, image_03, a Velodyne sweep and non-blank image and Velodyne stamps
+// are written (KITTI leaves blank lines for dropped sweeps); the others are listed as skipped.
+// Exit status: 0 written, 1 bad input or write failure, 2 bad command line.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <boost/make_shared.hpp>
+#include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgcodecs.hpp>
+#include <ros/message_traits.h>
+#include <rosbag/bag.h>
+#include <rosbag/exceptions.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "lidar_stereo_fusion/core/lidar_projection.h"
+#include "lidar_stereo_fusion/io/kitti.h"
+#include "lidar_stereo_fusion/ros/calibration_msgs.h"
+
+namespace lsf = lidar_stereo_fusion;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr char kLeftFrame[] = "left_camera_optical_frame";
+constexpr char kRightFrame[] = "right_camera_optical_frame";
+constexpr char kVelodyneFrame[] = "velodyne";
+constexpr char kLeftImageTopic[] = "/stereo/left/image_rect_color";
+constexpr char kLeftInfoTopic[] = "/stereo/left/camera_info";
+constexpr char kRightImageTopic[] = "/stereo/right/image_rect_color";
+constexpr char kRightInfoTopic[] = "/stereo/right/camera_info";
+constexpr char kCloudTopic[] = "/velodyne_points";
+constexpr char kTfStaticTopic[] = "/tf_static";
+constexpr double kDefaultSweepPeriod = 0.1;  ///< HDL-64E at 10 Hz [s], when start/end are absent
+constexpr int kHdl64Rings = 64;
+
+/// Thrown for command-line mistakes (exit status 2).
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  std::string drive_dir;
+  std::string out;
+  std::string calib_dir;  ///< empty = parent of drive_dir
+  int max_frames = -1;    ///< -1 = all
+  rosbag::CompressionType compression = rosbag::compression::Uncompressed;
+};
+
+const char* usage() {
+  return "usage: kitti_to_bag --kitti-raw <date>/<drive>_sync --out <file.bag> [--frames N]\n"
+         "                    [--calib-dir <date folder>] [--compression none|lz4|bz2]\n"
+         "  Writes the frames that have image_02, image_03 and a Velodyne sweep (the first N with\n"
+         "  --frames) as /stereo/{left,right}/{image_rect_color,camera_info}, /velodyne_points\n"
+         "  and /tf_static. --calib-dir defaults to the drive folder's parent.\n";
+}
+
+Options parseOptions(int argc, char** argv) {
+  Options options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "-h" || arg == "--help") {
+      std::cout << usage();
+      std::exit(0);
+    }
+    if (i + 1 >= argc) throw UsageError("option " + arg + " needs a value");
+    const std::string value = argv[++i];
+    if (arg == "--kitti-raw") {
+      options.drive_dir = value;
+    } else if (arg == "--out") {
+      options.out = value;
+    } else if (arg == "--calib-dir") {
+      options.calib_dir = value;
+    } else if (arg == "--frames") {
+      size_t used = 0;
+      long n = 0;
+      try {
+        n = std::stol(value, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != value.size() || n <= 0) {
+        throw UsageError("--frames needs a positive integer, got '" + value + "'");
+      }
+      options.max_frames = static_cast<int>(std::min<long>(n, 1000000));
+    } else if (arg == "--compression") {
+      if (value == "none") {
+        options.compression = rosbag::compression::Uncompressed;
+      } else if (value == "lz4") {
+        options.compression = rosbag::compression::LZ4;
+      } else if (value == "bz2") {
+        options.compression = rosbag::compression::BZ2;
+      } else {
+        throw UsageError("--compression must be none, lz4 or bz2, got '" + value + "'");
+      }
+    } else {
+      throw UsageError("unknown option " + arg);
+    }
+  }
+  if (options.drive_dir.empty()) throw UsageError("--kitti-raw is required");
+  if (options.out.empty()) throw UsageError("--out is required");
+  if (options.calib_dir.empty()) {
+    fs::path drive(options.drive_dir);
+    if (!drive.has_filename()) drive = drive.parent_path();  // trailing slash
+    options.calib_dir = drive.has_parent_path() ? drive.parent_path().string() : ".";
+  }
+  return options;
+}
+
+/// Timestamps [s] of a KITTI timestamps file indexed by frame (= line) number; blank lines (a
+/// dropped sample) give std::nullopt. Parsing is kitti::readTimestamps's, which skips blanks.
+std::vector<std::optional<double>> readTimestampsByFrame(const fs::path& path) {
+  const std::vector<double> stamps = lsf::kitti::readTimestamps(path.string());
+  std::ifstream in(path);
+  std::vector<std::optional<double>> by_frame;
+  size_t next = 0;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) {
+      by_frame.emplace_back();
+    } else if (next < stamps.size()) {
+      by_frame.emplace_back(stamps[next++]);
+    }
+  }
+  if (next != stamps.size()) {
+    throw std::runtime_error("KITTI: " + path.string() + " changed while being read");
+  }
+  return by_frame;
+}
+
+std::optional<double> stampOf(const std::vector<std::optional<double>>& stamps, size_t frame) {
+  return frame < stamps.size() ? stamps[frame] : std::nullopt;
+}
+
+/// Names (file stems) of the files with `extension` in `dir`, sorted; empty if no such folder.
+std::set<std::string> stemsIn(const fs::path& dir, const std::string& extension) {
+  std::set<std::string> stems;
+  if (!fs::is_directory(dir)) return stems;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.is_regular_file() && entry.path().extension() == extension) {
+      stems.insert(entry.path().stem().string());
+    }
+  }
+  return stems;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+/// One frame to write, with its stamps.
+struct FrameToWrite {
+  lsf::kitti::Frame files;
+  ros::Time image_stamp, cloud_stamp;
+  double sweep_period = kDefaultSweepPeriod;  ///< [s] timestamps_end - timestamps_start
+  double stamp_after_start = kDefaultSweepPeriod;  ///< [s] from the sweep start to cloud_stamp
+};
+
+/// PointCloud2 with x, y, z, intensity (float32), ring (uint16), time (float32 [s] from the
+/// stamp), 24-byte points (ring padded to 4 bytes so that `time` is aligned).
+sensor_msgs::PointCloud2 cloudMsg(const lsf::LidarCloud& cloud, const std_msgs::Header& header) {
+  sensor_msgs::PointCloud2 msg;
+  msg.header = header;
+  msg.height = 1;
+  msg.width = static_cast<uint32_t>(cloud.size());
+  msg.is_bigendian = false;
+  msg.point_step = 24;
+  msg.row_step = msg.point_step * msg.width;
+  const auto field = [](const std::string& name, uint32_t offset, uint8_t type) {
+    sensor_msgs::PointField f;
+    f.name = name;
+    f.offset = offset;
+    f.datatype = type;
+    f.count = 1;
+    return f;
+  };
+  using sensor_msgs::PointField;
+  msg.fields = {field("x", 0, PointField::FLOAT32),        field("y", 4, PointField::FLOAT32),
+                field("z", 8, PointField::FLOAT32),        field("intensity", 12, PointField::FLOAT32),
+                field("ring", 16, PointField::UINT16),     field("time", 20, PointField::FLOAT32)};
+  msg.data.assign(static_cast<size_t>(msg.row_step), 0);
+  bool dense = true;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const lsf::LidarPoint& p = cloud[i];
+    uint8_t* out = &msg.data[i * msg.point_step];
+    const float xyzi[4] = {p.x, p.y, p.z, p.intensity};
+    const uint16_t ring = static_cast<uint16_t>(std::clamp(p.ring, 0, 65535));
+    std::memcpy(out, xyzi, sizeof(xyzi));
+    std::memcpy(out + 16, &ring, sizeof(ring));
+    std::memcpy(out + 20, &p.time, sizeof(p.time));
+    dense = dense && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  }
+  msg.is_dense = dense;
+  return msg;
+}
+
+/// Loads a sweep, recovers its rings and sets each point's time [s] relative to the cloud stamp
+/// from its azimuth.
+lsf::LidarCloud loadSweep(const FrameToWrite& frame) {
+  lsf::LidarCloud cloud = lsf::kitti::readVelodyneBin(frame.files.velodyne);
+  if (cloud.empty()) {
+    throw std::runtime_error("KITTI: Velodyne sweep " + frame.files.velodyne + " is empty");
+  }
+  const int rings = lsf::recoverRingsBySweepOrder(cloud);
+  if (rings != kHdl64Rings) {
+    std::cerr << "kitti_to_bag: warning: frame " << frame.files.name << ": recovered " << rings
+              << " rings, an HDL-64E sweep has " << kHdl64Rings << "\n";
+  }
+  for (lsf::LidarPoint& p : cloud) {
+    const double azimuth = std::atan2(static_cast<double>(p.y), static_cast<double>(p.x));
+    // Clockwise from the rear (azimuth +pi) at the sweep start to the rear again (-pi) at its end.
+    const double since_start = (M_PI - azimuth) / (2.0 * M_PI) * frame.sweep_period;
+    p.time = static_cast<float>(since_start - frame.stamp_after_start);
+  }
+  return cloud;
+}
+
+sensor_msgs::ImagePtr imageMsg(const std::string& path, const std_msgs::Header& header,
+                               const lsf::StereoCamera& camera) {
+  const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);  // KITTI RGB PNG -> BGR
+  if (image.empty()) throw std::runtime_error("KITTI: cannot read image " + path);
+  if (image.cols != camera.width || image.rows != camera.height) {
+    throw std::runtime_error("KITTI: image " + path + " is " + std::to_string(image.cols) + "x" +
+                             std::to_string(image.rows) + " but the calibration (S_rect_02) says " +
+                             std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  }
+  return cv_bridge::CvImage(header, "bgr8", image).toImageMsg();
+}
+
+/// Connection header that makes `rosbag play` re-advertise the topic latched (as tf2 publishes
+/// /tf_static), so that late subscribers still get the static transforms.
+template <typename Msg>
+boost::shared_ptr<ros::M_string> latchedConnectionHeader() {
+  auto header = boost::make_shared<ros::M_string>();
+  (*header)["callerid"] = "/kitti_to_bag";
+  (*header)["latching"] = "1";
+  (*header)["type"] = ros::message_traits::datatype<Msg>();
+  (*header)["md5sum"] = ros::message_traits::md5sum<Msg>();
+  (*header)["message_definition"] = ros::message_traits::definition<Msg>();
+  return header;
+}
+
+/// Chooses the frames to write and their stamps; prints what is skipped and why.
+std::vector<FrameToWrite> selectFrames(const Options& options) {
+  const fs::path drive(options.drive_dir);
+  if (!fs::is_directory(drive)) {
+    throw std::runtime_error("KITTI: --kitti-raw " + options.drive_dir + " is not a folder");
+  }
+  const std::vector<lsf::kitti::Frame> complete = lsf::kitti::listFrames(options.drive_dir);
+
+  // Report files that cannot form a frame (e.g. LiDAR-only frames between the stereo frames).
+  std::set<std::string> all = stemsIn(drive / "image_02" / "data", ".png");
+  const std::set<std::string> right = stemsIn(drive / "image_03" / "data", ".png");
+  const std::set<std::string> sweeps = stemsIn(drive / "velodyne_points" / "data", ".bin");
+  all.insert(right.begin(), right.end());
+  all.insert(sweeps.begin(), sweeps.end());
+  std::set<std::string> complete_names;
+  for (const auto& f : complete) complete_names.insert(f.name);
+  std::vector<std::string> incomplete;
+  for (const auto& name : all) {
+    if (!complete_names.count(name)) incomplete.push_back(name);
+  }
+  if (!incomplete.empty()) {
+    std::cerr << "kitti_to_bag: skipping " << incomplete.size()
+              << " frame(s) without all of image_02, image_03 and a Velodyne sweep: "
+              << joined(incomplete) << "\n";
+  }
+  if (complete.empty()) {
+    throw std::runtime_error("KITTI: " + options.drive_dir +
+                             " has no frame with image_02, image_03 and velodyne_points data");
+  }
+
+  // Sweep stamps: the sweep end (timestamps_end.txt), as velodyne_driver stamps a scan at its
+  // last packet; without that file, the forward-facing instant (timestamps.txt, mid-sweep).
+  const fs::path velo_dir = drive / "velodyne_points";
+  const bool have_end = fs::is_regular_file(velo_dir / "timestamps_end.txt");
+  const auto image_stamps = readTimestampsByFrame(drive / "image_02" / "timestamps.txt");
+  const auto sweep_stamps =
+      readTimestampsByFrame(velo_dir / (have_end ? "timestamps_end.txt" : "timestamps.txt"));
+  std::vector<std::optional<double>> starts;
+  if (fs::is_regular_file(velo_dir / "timestamps_start.txt")) {
+    starts = readTimestampsByFrame(velo_dir / "timestamps_start.txt");
+  }
+  if (!have_end) {
+    std::cerr << "kitti_to_bag: no velodyne_points/timestamps_end.txt: stamping sweeps at the "
+                 "forward-facing instant (timestamps.txt)\n";
+  }
+
+  std::vector<FrameToWrite> frames;
+  std::vector<std::string> unstamped;
+  for (const auto& files : complete) {
+    if (options.max_frames > 0 && static_cast<int>(frames.size()) >= options.max_frames) break;
+    size_t index = 0;
+    try {
+      size_t used = 0;
+      index = std::stoul(files.name, &used);
+      if (used != files.name.size()) throw std::invalid_argument(files.name);
+    } catch (const std::exception&) {
+      throw std::runtime_error("KITTI: frame file name " + files.name +
+                               " is not a frame number (expected e.g. 0000000005)");
+    }
+    const auto image_stamp = stampOf(image_stamps, index);
+    const auto sweep_stamp = stampOf(sweep_stamps, index);
+    if (!image_stamp || !sweep_stamp) {
+      unstamped.push_back(files.name);
+      continue;
+    }
+    FrameToWrite frame;
+    frame.files = files;
+    frame.image_stamp = ros::Time(*image_stamp);
+    frame.cloud_stamp = ros::Time(*sweep_stamp);
+    const auto start = stampOf(starts, index);
+    if (have_end && start && *sweep_stamp > *start && *sweep_stamp - *start < 1.0) {
+      frame.sweep_period = *sweep_stamp - *start;
+    }
+    frame.stamp_after_start = have_end ? frame.sweep_period : 0.5 * frame.sweep_period;
+    frames.push_back(frame);
+  }
+  if (!unstamped.empty()) {
+    std::cerr << "kitti_to_bag: skipping " << unstamped.size()
+              << " frame(s) with no line (or a blank line) in the image_02 or velodyne_points "
+                 "timestamps: "
+              << joined(unstamped) << "\n";
+  }
+  if (frames.empty()) throw std::runtime_error("KITTI: no frame of " + options.drive_dir +
+                                               " has both an image and a Velodyne timestamp");
+  return frames;
+}
+
+std::string partialPath(const Options& options) { return options.out + ".partial"; }
+
+void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
+              const std::vector<FrameToWrite>& frames) {
+  const sensor_msgs::CameraInfo left_info_base =
+      lsf::rectifiedCameraInfo(calib.camera, kLeftFrame, false);
+  const sensor_msgs::CameraInfo right_info_base =
+      lsf::rectifiedCameraInfo(calib.camera, kRightFrame, true);
+
+  // Written under a temporary name and renamed when complete, so that a failed conversion never
+  // leaves a truncated bag under the requested name.
+  rosbag::Bag bag;
+  bag.open(partialPath(options), rosbag::bagmode::Write);
+  bag.setCompression(options.compression);
+
+  // Static transforms first, at the earliest stamp of the bag (their stamps do not matter to
+  // tf2's static buffer; a first message time keeps `rosbag play` from waiting).
+  ros::Time first = frames.front().image_stamp;
+  for (const auto& f : frames) first = std::min({first, f.image_stamp, f.cloud_stamp});
+  tf2_msgs::TFMessage tf_static;
+  tf_static.transforms.push_back(lsf::kittiVelodyneToCamera(calib, kVelodyneFrame, kLeftFrame, first));
+  tf_static.transforms.push_back(lsf::stereoLeftToRight(calib.camera, kLeftFrame, kRightFrame, first));
+  bag.write(kTfStaticTopic, first, tf_static, latchedConnectionHeader<tf2_msgs::TFMessage>());
+
+  uint32_t seq = 0;
+  for (const FrameToWrite& frame : frames) {
+    std_msgs::Header left_header, right_header, cloud_header;
+    left_header.seq = right_header.seq = cloud_header.seq = seq++;
+    left_header.stamp = right_header.stamp = frame.image_stamp;
+    left_header.frame_id = kLeftFrame;
+    right_header.frame_id = kRightFrame;
+    cloud_header.stamp = frame.cloud_stamp;
+    cloud_header.frame_id = kVelodyneFrame;
+
+    sensor_msgs::CameraInfo left_info = left_info_base, right_info = right_info_base;
+    left_info.header = left_header;
+    right_info.header = right_header;
+    const sensor_msgs::PointCloud2 cloud = cloudMsg(loadSweep(frame), cloud_header);
+    bag.write(kCloudTopic, frame.cloud_stamp, cloud);
+    bag.write(kLeftInfoTopic, frame.image_stamp, left_info);
+    bag.write(kLeftImageTopic, frame.image_stamp,
+              imageMsg(frame.files.left_image, left_header, calib.camera));
+    bag.write(kRightInfoTopic, frame.image_stamp, right_info);
+    bag.write(kRightImageTopic, frame.image_stamp,
+              imageMsg(frame.files.right_image, right_header, calib.camera));
+    std::cout << "kitti_to_bag: frame " << frame.files.name << ": images at "
+              << frame.image_stamp << " s, " << cloud.width << " points at " << frame.cloud_stamp
+              << " s\n";
+  }
+  bag.close();
+  fs::rename(partialPath(options), options.out);
+}
+
+void removePartial(const Options& options) {
+  std::error_code ignored;
+  fs::remove(partialPath(options), ignored);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options;
+  try {
+    options = parseOptions(argc, argv);
+  } catch (const UsageError& e) {
+    std::cerr << "kitti_to_bag: " << e.what() << "\n" << usage();
+    return 2;
+  }
+  try {
+    const lsf::kitti::Calibration calib = lsf::kitti::readCalibration(options.calib_dir);
+    const std::vector<FrameToWrite> frames = selectFrames(options);
+    writeBag(options, calib, frames);
+    std::cout << "kitti_to_bag: wrote " << frames.size() << " frame(s) to " << options.out << "\n";
+  } catch (const rosbag::BagException& e) {
+    std::cerr << "kitti_to_bag: cannot write bag " << options.out << ": " << e.what() << "\n";
+    removePartial(options);
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "kitti_to_bag: " << e.what() << "\n";
+    removePartial(options);
+    return 1;
+  }
+  return 0;
+}

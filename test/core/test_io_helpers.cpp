@@ -1,0 +1,189 @@
+// The small io helpers on synthetic input with exact answers: ring hold-out, row-sampled
+// pseudo-LiDAR, colour maps, tables, progress bar, command line.
+#include <cmath>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "lidar_stereo_fusion/io/cli.h"
+#include "lidar_stereo_fusion/io/holdout.h"
+#include "lidar_stereo_fusion/io/middlebury.h"
+#include "lidar_stereo_fusion/io/report.h"
+#include "lidar_stereo_fusion/io/visualization.h"
+
+namespace lidar_stereo_fusion {
+namespace {
+
+StereoCamera camera() {
+  StereoCamera c;
+  c.fx = c.fy = 100.0;
+  c.cx = 10.0;
+  c.cy = 5.0;
+  c.baseline = 0.5;
+  c.width = 20;
+  c.height = 10;
+  return c;
+}
+
+LidarPoint point(float x, float y, float z, int ring) {
+  LidarPoint p;
+  p.x = x;
+  p.y = y;
+  p.z = z;
+  p.ring = ring;
+  return p;
+}
+
+TEST(RingHoldout, SplitsByRingParityAndRejectsPointsWithoutRing) {
+  const LidarCloud cloud = {point(0, 0, 1, 0), point(0, 0, 2, 1), point(0, 0, 3, 2),
+                            point(0, 0, 4, 5)};
+  const RingSplit split = splitRingsEvenOdd(cloud);
+  ASSERT_EQ(split.fed.size(), 2u);
+  ASSERT_EQ(split.held_out.size(), 2u);
+  EXPECT_EQ(split.fed[1].z, 3.f);
+  EXPECT_EQ(split.held_out[1].ring, 5);
+  EXPECT_THROW(splitRingsEvenOdd({point(0, 0, 1, -1)}), std::invalid_argument);
+}
+
+TEST(RingHoldout, ReferenceDepthIsTheNearestZPerRoundedPixel) {
+  // Identity transform: the LiDAR frame is the camera frame.
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  const LidarCloud held = {
+      point(0.f, 0.f, 10.f, 1),      // u = 10, v = 5
+      point(0.048f, 0.f, 8.f, 1),    // u = 10.6 -> 11, v = 5
+      point(0.004f, 0.f, 9.f, 1),    // u = 10.04 -> 10: nearer than 10 m, wins
+      point(-0.2f, -0.1f, 2.f, 1),   // u = 0, v = 0
+      point(1.f, 0.f, 2.f, 1),       // u = 60: outside
+      point(0.f, 0.f, 0.2f, 1),      // nearer than min_depth 0.5
+      point(0.f, 0.f, -5.f, 1),      // behind
+  };
+  ProjectionParams params;
+  const cv::Mat1f depth = projectReferenceDepth(held, identity, camera(), params);
+  ASSERT_EQ(depth.size(), cv::Size(20, 10));
+  EXPECT_EQ(depth(5, 10), 9.f);
+  EXPECT_EQ(depth(5, 11), 8.f);
+  EXPECT_EQ(depth(0, 0), 2.f);
+  EXPECT_EQ(cv::countNonZero(depth), 3);
+}
+
+TEST(RingHoldout, MakeRingHoldoutFeedsEvenRingsAndFailsWithoutReference) {
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  const LidarCloud cloud = {point(0, 0, 10, 0), point(0, 0, 12, 1), point(0.1f, 0, 12, 2)};
+  const HoldoutCase holdout = makeRingHoldout(cloud, identity, camera(), ProjectionParams());
+  EXPECT_EQ(holdout.fed.size(), 2u);
+  EXPECT_EQ(holdout.reference_depth(5, 10), 12.f);
+  EXPECT_EQ(cv::countNonZero(holdout.reference_depth), 1);
+  EXPECT_THROW(makeRingHoldout({point(0, 0, 10, 0)}, identity, camera(), ProjectionParams()),
+               std::invalid_argument);
+}
+
+TEST(PseudoLidar, EvenlySpacedRowsWithRingIdsAndOnlyKnownDisparities) {
+  cv::Mat1f gt(8, 5, 3.f);
+  gt(1, 2) = 0.f;  // unknown: not sampled
+  const SparseDisparity sparse = sampleRowsAsScanLines(gt, 4);  // rows 1, 3, 5, 7
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 5; ++x) {
+      const bool sampled = y % 2 == 1 && !(y == 1 && x == 2);
+      EXPECT_EQ(sparse.disparity(y, x), sampled ? 3.f : 0.f) << x << "," << y;
+      EXPECT_EQ(sparse.ring(y, x), sampled ? y / 2 : -1) << x << "," << y;
+    }
+  }
+  EXPECT_EQ(sparse.points_in_image, 19);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 1), std::invalid_argument);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 9), std::invalid_argument);
+}
+
+TEST(PseudoLidar, RightViewShiftsByTheRoundedDisparityAndTheNearerSampleWins) {
+  SparseDisparity left;
+  left.disparity = cv::Mat1f(1, 10, 0.f);
+  left.ring = cv::Mat1s(1, 10, static_cast<int16_t>(-1));
+  left.disparity(0, 5) = 2.4f;  // -> 2.6 -> 3
+  left.ring(0, 5) = 7;
+  left.disparity(0, 7) = 4.f;   // -> 3: nearer, wins
+  left.ring(0, 7) = 8;
+  left.disparity(0, 1) = 3.f;   // -> -2: outside
+  const SparseDisparity right = shiftToRightView(left);
+  EXPECT_EQ(right.disparity(0, 3), 4.f);
+  EXPECT_EQ(right.ring(0, 3), 8);
+  EXPECT_EQ(cv::countNonZero(right.disparity), 1);
+  EXPECT_EQ(right.points_in_image, 2);
+}
+
+TEST(Visualization, EmptyPixelsAreBlackAndTheScaleFollowsTheMaximum) {
+  cv::Mat1f d(1, 3, 0.f);
+  d(0, 1) = 10.f;
+  d(0, 2) = 20.f;
+  const cv::Mat color = colorizeDisparity(d);
+  ASSERT_EQ(color.type(), CV_8UC3);
+  EXPECT_EQ(color.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 0, 0));
+  EXPECT_NE(color.at<cv::Vec3b>(0, 1), color.at<cv::Vec3b>(0, 2));
+  // A fixed scale of 20 px: 20 maps to the same colour as in the automatic scale.
+  EXPECT_EQ(colorizeDisparity(d, 20.0).at<cv::Vec3b>(0, 2), color.at<cv::Vec3b>(0, 2));
+
+  const cv::Mat1f z = (cv::Mat1f(1, 3) << 0, 5, std::nanf(""));
+  const cv::Mat depth = colorizeDepth(z, 80.0);
+  EXPECT_EQ(depth.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 0, 0));
+  EXPECT_EQ(depth.at<cv::Vec3b>(0, 2), cv::Vec3b(0, 0, 0));
+  EXPECT_NE(depth.at<cv::Vec3b>(0, 1), cv::Vec3b(0, 0, 0));
+
+  const cv::Mat1f ref = (cv::Mat1f(1, 3) << 0, 10, 10);
+  const cv::Mat1f est = (cv::Mat1f(1, 3) << 3, 10, 0);
+  const cv::Mat error = colorizeError(est, ref, 5.0);
+  EXPECT_EQ(error.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 0, 0));  // no reference
+  // Missing estimate shows as the maximum error, like an error of 5 px.
+  EXPECT_EQ(error.at<cv::Vec3b>(0, 2),
+            colorizeError((cv::Mat1f(1, 1) << 15), (cv::Mat1f(1, 1) << 10), 5.0).at<cv::Vec3b>(0, 0));
+  EXPECT_THROW(colorizeError(est, cv::Mat1f(1, 2, 1.f)), std::invalid_argument);
+
+  const cv::Mat overlay = overlaySparse(cv::Mat(5, 5, CV_8UC3, cv::Scalar::all(100)), cv::Mat1f(5, 5, 0.f));
+  EXPECT_EQ(overlay.at<cv::Vec3b>(2, 2), cv::Vec3b(40, 40, 40));  // darkened to 40 %
+  EXPECT_THROW(overlaySparse(cv::Mat(5, 5, CV_8UC3), cv::Mat1f(4, 5)), std::invalid_argument);
+}
+
+TEST(Report, TablesMedianAndProgress) {
+  DepthMetrics m;
+  m.mae_mm = 302.4;
+  m.rmse_mm = 1282.0;
+  m.bad2 = 0.0452;
+  m.count = 7;
+  const std::string table = formatDepthTable({{"fused_bi", m}});
+  EXPECT_NE(table.find("| fused_bi | 302 | 1282 |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| 4.52 |"), std::string::npos) << table;
+  EXPECT_DOUBLE_EQ(median({3, 1, 2}), 2.0);
+  EXPECT_DOUBLE_EQ(median({4, 1, 2, 3}), 2.5);
+  EXPECT_DOUBLE_EQ(median({}), 0.0);
+  FusionStats a, b, c;
+  a.patchmatch_ms = 10;
+  b.patchmatch_ms = 30;
+  c.patchmatch_ms = 200;
+  const std::string timing = formatTimingSummary({a, b, c});
+  EXPECT_NE(timing.find("| PatchMatch | 80.0 | 30.0 |"), std::string::npos) << timing;
+
+  std::ostringstream out;
+  ProgressBar bar(out, 4, false, 8);
+  bar.update(2, "frame");
+  EXPECT_EQ(out.str().substr(0, 22), "[====>   ] 2/4 frame  ");
+}
+
+TEST(CommandLine, OptionsFlagsAndErrors) {
+  const char* argv[] = {"tool", "--frames", "3", "--save-vis", "--method", "pms"};
+  const CommandLine cl(6, argv, {"--frames", "--method", "--out"}, {"--save-vis"});
+  EXPECT_TRUE(cl.has("--save-vis"));
+  EXPECT_FALSE(cl.has("--out"));
+  EXPECT_EQ(cl.intValue("--frames", 0, 1, 10), 3);
+  EXPECT_EQ(cl.value("--out", "x"), "x");
+  EXPECT_EQ(cl.choice("--method", "fused_bi", {"fused_bi", "pms"}), "pms");
+  EXPECT_THROW(cl.intValue("--frames", 0, 5, 10), UsageError);
+  EXPECT_THROW(cl.choice("--method", "", {"fused_bi"}), UsageError);
+  const char* unknown[] = {"tool", "--frame", "3"};
+  EXPECT_THROW(CommandLine(3, unknown, {"--frames"}, {}), UsageError);
+  const char* missing[] = {"tool", "--frames"};
+  EXPECT_THROW(CommandLine(2, missing, {"--frames"}, {}), UsageError);
+  const char* twice[] = {"tool", "--frames", "1", "--frames", "2"};
+  EXPECT_THROW(CommandLine(5, twice, {"--frames"}, {}), UsageError);
+  const char* junk[] = {"tool", "--frames", "3x"};
+  EXPECT_THROW(CommandLine(3, junk, {"--frames"}, {}).intValue("--frames", 0, 0, 9), UsageError);
+}
+
+}  // namespace
+}  // namespace lidar_stereo_fusion

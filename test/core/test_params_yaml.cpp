@@ -1,0 +1,217 @@
+// FusionParams <-> YAML: every field round-trips, partial files override only what they name,
+// typos and bad values are errors naming the key.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "lidar_stereo_fusion/io/params_yaml.h"
+
+namespace lidar_stereo_fusion {
+namespace {
+
+namespace fs = std::filesystem;
+
+class YamlFile {
+ public:
+  explicit YamlFile(const std::string& text = "") {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = (fs::temp_directory_path() / ("lsf_params_" + std::string(info->name()) + "_" +
+                                          std::to_string(::getpid()) + ".yaml"))
+                .string();
+    if (!text.empty()) std::ofstream(path_) << text;
+  }
+  ~YamlFile() { fs::remove(path_); }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+/// Every field set away from its default (and still valid).
+FusionParams everyFieldChanged() {
+  FusionParams p;
+  p.method = Method::kLidarBF;
+  p.projection.min_depth = 1.25;
+  p.projection.max_depth = 90.5;
+  p.bi.max_gap_px = 7;
+  p.bi.max_jump_disp = 3.5;
+  p.bi.max_disp_diff = 2.25;
+  p.bi.max_color_diff = 45.0;
+  p.bi.search_lines = 3;
+  p.bi.max_interp_rows = 33;
+  p.bf.radius = 4;
+  p.bf.sigma_space = 2.5;
+  p.bf.sigma_range = 1.75;
+  p.bf.min_support = 2;
+  PatchMatchParams& m = p.patchmatch;
+  m.window_radius = 9;
+  m.window_stride = 3;
+  m.weight_delta = 12.5;
+  m.alpha = 0.25;
+  m.beta = 0.125;
+  m.gamma = 0.625;
+  m.lambda_col = 11.0;
+  m.lambda_grad = 3.0;
+  m.lambda_disp = 4.5;
+  m.iterations = 5;
+  m.slanted = false;
+  m.init_from_prior = false;
+  m.init_normal_from_prior = false;
+  m.use_lidar_bounds = false;
+  m.bound_margin = 0.75;
+  m.min_refine_range = 0.5;
+  m.min_disparity = 2.0;
+  m.max_disparity = 100.0;
+  m.view_propagation = false;
+  m.lr_check = false;
+  m.lr_max_diff = 1.5;
+  m.num_threads = 3;
+  m.seed = 18446744073709551557ull;  // beyond int32 and double precision
+  return p;
+}
+
+void expectSame(const FusionParams& a, const FusionParams& b) {
+  EXPECT_EQ(a.method, b.method);
+  EXPECT_EQ(a.projection.min_depth, b.projection.min_depth);
+  EXPECT_EQ(a.projection.max_depth, b.projection.max_depth);
+  EXPECT_EQ(a.bi.max_gap_px, b.bi.max_gap_px);
+  EXPECT_EQ(a.bi.max_jump_disp, b.bi.max_jump_disp);
+  EXPECT_EQ(a.bi.max_disp_diff, b.bi.max_disp_diff);
+  EXPECT_EQ(a.bi.max_color_diff, b.bi.max_color_diff);
+  EXPECT_EQ(a.bi.search_lines, b.bi.search_lines);
+  EXPECT_EQ(a.bi.max_interp_rows, b.bi.max_interp_rows);
+  EXPECT_EQ(a.bf.radius, b.bf.radius);
+  EXPECT_EQ(a.bf.sigma_space, b.bf.sigma_space);
+  EXPECT_EQ(a.bf.sigma_range, b.bf.sigma_range);
+  EXPECT_EQ(a.bf.min_support, b.bf.min_support);
+  const PatchMatchParams &x = a.patchmatch, &y = b.patchmatch;
+  EXPECT_EQ(x.window_radius, y.window_radius);
+  EXPECT_EQ(x.window_stride, y.window_stride);
+  EXPECT_EQ(x.weight_delta, y.weight_delta);
+  EXPECT_EQ(x.alpha, y.alpha);
+  EXPECT_EQ(x.beta, y.beta);
+  EXPECT_EQ(x.gamma, y.gamma);
+  EXPECT_EQ(x.lambda_col, y.lambda_col);
+  EXPECT_EQ(x.lambda_grad, y.lambda_grad);
+  EXPECT_EQ(x.lambda_disp, y.lambda_disp);
+  EXPECT_EQ(x.iterations, y.iterations);
+  EXPECT_EQ(x.slanted, y.slanted);
+  EXPECT_EQ(x.init_from_prior, y.init_from_prior);
+  EXPECT_EQ(x.init_normal_from_prior, y.init_normal_from_prior);
+  EXPECT_EQ(x.use_lidar_bounds, y.use_lidar_bounds);
+  EXPECT_EQ(x.bound_margin, y.bound_margin);
+  EXPECT_EQ(x.min_refine_range, y.min_refine_range);
+  EXPECT_EQ(x.min_disparity, y.min_disparity);
+  EXPECT_EQ(x.max_disparity, y.max_disparity);
+  EXPECT_EQ(x.view_propagation, y.view_propagation);
+  EXPECT_EQ(x.lr_check, y.lr_check);
+  EXPECT_EQ(x.lr_max_diff, y.lr_max_diff);
+  EXPECT_EQ(x.num_threads, y.num_threads);
+  EXPECT_EQ(x.seed, y.seed);
+}
+
+/// The message of the runtime_error `load` throws ("" when none).
+std::string loadError(const std::string& text) {
+  YamlFile file(text);
+  FusionParams p;
+  try {
+    loadParamsYaml(file.path(), p);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ParamsYaml, EveryFieldRoundTrips) {
+  const FusionParams changed = everyFieldChanged();
+  changed.validate();
+  YamlFile file;
+  saveParamsYaml(file.path(), changed);
+  FusionParams loaded;  // defaults
+  loadParamsYaml(file.path(), loaded);
+  expectSame(loaded, changed);
+}
+
+TEST(ParamsYaml, DefaultsRoundTripAndThirdDecimalsSurvive) {
+  FusionParams p;
+  p.patchmatch.alpha = 0.1;
+  p.patchmatch.gamma = 0.9;  // 0.1 + 0.9 needs the exact doubles back
+  YamlFile file;
+  saveParamsYaml(file.path(), p);
+  FusionParams loaded = everyFieldChanged();
+  loadParamsYaml(file.path(), loaded);
+  expectSame(loaded, p);
+}
+
+TEST(ParamsYaml, PartialRosparamStyleFileOverridesOnlyWhatItNames) {
+  YamlFile file(
+      "# a rosparam file: no %YAML directive\n"
+      "method: pms\n"
+      "projection: {max_depth: 120}\n"
+      "patchmatch:\n"
+      "  window_radius: 8\n"
+      "  slanted: false\n"
+      "  lr_check: 0\n"
+      "  seed: 7\n");
+  FusionParams p = everyFieldChanged();
+  FusionParams expected = p;
+  loadParamsYaml(file.path(), p);
+  expected.method = Method::kPlainPMS;
+  expected.projection.max_depth = 120.0;
+  expected.patchmatch.window_radius = 8;
+  expected.patchmatch.slanted = false;
+  expected.patchmatch.lr_check = false;
+  expected.patchmatch.seed = 7;
+  expectSame(p, expected);
+}
+
+TEST(ParamsYaml, OpenCvStyleFileWithDirectiveAndEmptyFileAreAccepted) {
+  YamlFile with_directive("%YAML:1.0\n---\nbi:\n  max_gap_px: 5\n  search_lines: 1\n");
+  FusionParams p;
+  loadParamsYaml(with_directive.path(), p);
+  EXPECT_EQ(p.bi.max_gap_px, 5);
+  EXPECT_EQ(p.bi.search_lines, 1);
+  YamlFile empty("# nothing to change\n");
+  FusionParams q = everyFieldChanged();
+  loadParamsYaml(empty.path(), q);
+  expectSame(q, everyFieldChanged());
+}
+
+TEST(ParamsYaml, UnknownKeysAreErrorsNamingTheKey) {
+  const std::string in_section = loadError("patchmatch:\n  window_radious: 5\n");
+  EXPECT_NE(in_section.find("'window_radious'"), std::string::npos) << in_section;
+  EXPECT_NE(in_section.find("patchmatch"), std::string::npos) << in_section;
+  const std::string top = loadError("methd: pms\n");
+  EXPECT_NE(top.find("'methd'"), std::string::npos) << top;
+}
+
+TEST(ParamsYaml, WrongTypesAndInvalidValuesAreErrorsNamingTheKey) {
+  const std::string not_number = loadError("bf:\n  sigma_space: wide\n");
+  EXPECT_NE(not_number.find("'sigma_space'"), std::string::npos) << not_number;
+  const std::string not_int = loadError("bi:\n  max_gap_px: 2.5\n");
+  EXPECT_NE(not_int.find("'max_gap_px'"), std::string::npos) << not_int;
+  const std::string not_bool = loadError("patchmatch:\n  slanted: maybe\n");
+  EXPECT_NE(not_bool.find("'slanted'"), std::string::npos) << not_bool;
+  const std::string negative_seed = loadError("patchmatch:\n  seed: -1\n");
+  EXPECT_NE(negative_seed.find("'seed'"), std::string::npos) << negative_seed;
+  const std::string method = loadError("method: magic\n");
+  EXPECT_NE(method.find("magic"), std::string::npos) << method;
+  const std::string section = loadError("bi: 3\n");
+  EXPECT_NE(section.find("'bi'"), std::string::npos) << section;
+  const std::string invalid = loadError("patchmatch:\n  window_radius: -2\n");
+  EXPECT_NE(invalid.find("window_radius"), std::string::npos) << invalid;
+}
+
+TEST(ParamsYaml, FailedLoadLeavesParamsUntouchedAndMissingFileIsAnError) {
+  YamlFile file("bi:\n  max_gap_px: 5\n  nonsense: 1\n");
+  FusionParams p;
+  EXPECT_THROW(loadParamsYaml(file.path(), p), std::runtime_error);
+  EXPECT_EQ(p.bi.max_gap_px, BIParams().max_gap_px);
+  EXPECT_THROW(loadParamsYaml("/nonexistent/params.yaml", p), std::runtime_error);
+  EXPECT_THROW(saveParamsYaml("/nonexistent/dir/params.yaml", p), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,793 @@
+// rostest of lidar_stereo_fusion/FusionNodelet, run against the nodelet (fusion_nodelet.test),
+// the fusion_node executable (fusion_node.test) and with approximate sync
+// (fusion_approx_sync.test). The test publishes synthetic input itself: frames of the simulated
+// street (320 x 120, sim::generateStreetFrame) with a static LiDAR -> camera transform, plus bad
+// input of every kind, and checks the outputs, the warnings on /rosout and that the process keeps
+// producing output after each bad input.
+//
+// Private parameters: ~process_node (the node whose process hosts the nodelet: the manager, or
+// fusion_node itself), ~fusion_node (the nodelet / node name, for its parameters and services).
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <dynamic_reconfigure/Reconfigure.h>
+#include <ros/master.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <rosgraph_msgs/Log.h>
+#include <sensor_msgs/image_encodings.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <stereo_msgs/DisparityImage.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include "data/data_guard.h"
+#include "lidar_stereo_fusion/FusionStats.h"
+#include "synthetic_input.h"
+
+namespace lsf = lidar_stereo_fusion;
+using lsf::test::kCameraFrame;
+using lsf::test::kLidarFrame;
+using lsf::test::kRightCameraFrame;
+
+namespace {
+
+constexpr int kWidth = 320, kHeight = 120;
+constexpr double kOutputTimeout = 20.0;  ///< [s] first frame includes pipeline warm-up
+constexpr double kNoOutputWait = 1.5;    ///< [s] > max_sweep_wait + processing of a small frame
+
+/// The output topics, relative to the fusion namespace.
+const std::vector<std::string> kOutputs = {"disparity",       "depth",           "depth/camera_info",
+                                           "points2",         "lidar_disparity", "disparity_image",
+                                           "stats"};
+
+/// How one input set is made.
+struct SetSpec {
+  int frame = 0;
+  std::string left_encoding = "bgr8", right_encoding = "bgr8";
+  int right_width = 0;  ///< 0 = same as the left image
+  enum class Cloud { kNormal, kNone, kEmpty, kNaN, kNoRing, kCustom } cloud = Cloud::kNormal;
+  sensor_msgs::PointCloud2Ptr custom_cloud;
+  std::string cloud_frame = kLidarFrame;
+  double cloud_offset = 0.0;  ///< sweep stamp - image stamp [s]
+  bool cloud_first = false;   ///< publish the sweep before the images
+  bool positive_tx = false;   ///< right camera_info with Tx = +fx * B
+  double right_stamp_offset = 0.0;  ///< right image/info stamp - left stamp [s]
+};
+
+class Harness {
+ public:
+  Harness() : pnh_("~") {
+    process_node_ = pnh_.param<std::string>("process_node", "/fusion/fusion_manager");
+    fusion_node_ = pnh_.param<std::string>("fusion_node", "/fusion/fusion");
+    ns_ = pnh_.param<std::string>("fusion_ns", "/fusion");
+    frames_ = lsf::test::makeFrames(3, kWidth, kHeight);
+    left_image_ = nh_.advertise<sensor_msgs::Image>("/stereo/left/image_rect_color", 5);
+    left_info_ = nh_.advertise<sensor_msgs::CameraInfo>("/stereo/left/camera_info", 5);
+    right_image_ = nh_.advertise<sensor_msgs::Image>("/stereo/right/image_rect_color", 5);
+    right_info_ = nh_.advertise<sensor_msgs::CameraInfo>("/stereo/right/camera_info", 5);
+    cloud_ = nh_.advertise<sensor_msgs::PointCloud2>("/velodyne_points", 5);
+    rosout_ = nh_.subscribe("/rosout", 200, &Harness::logCb, this);
+    addStaticTf(frames_[0].T_cam_lidar, kLidarFrame);
+    last_stamp_ = ros::Time::now();
+  }
+
+  const std::vector<lsf::sim::SyntheticFrame>& frames() const { return frames_; }
+  const std::string& processNode() const { return process_node_; }
+  const std::string& fusionNode() const { return fusion_node_; }
+  std::string output(const std::string& name) const { return ns_ + "/" + name; }
+
+  void addStaticTf(const Eigen::Isometry3d& T_cam_lidar, const std::string& lidar_frame) {
+    tfs_.push_back(lsf::test::lidarToCameraTf(T_cam_lidar, kCameraFrame, lidar_frame));
+    tfs_.back().header.stamp = ros::Time::now();
+    tf_broadcaster_.sendTransform(tfs_);
+  }
+
+  // --- inputs ------------------------------------------------------------------------------------
+  std::vector<ros::Publisher*> inputs() {
+    return {&left_image_, &left_info_, &right_image_, &right_info_, &cloud_};
+  }
+  bool inputsSubscribed(bool expected, double timeout) {
+    return waitFor(timeout, [&] {
+      for (auto* p : inputs()) {
+        if ((p->getNumSubscribers() > 0) != expected) return false;
+      }
+      return true;
+    });
+  }
+
+  /// A stamp newer than every one used so far (0.2 s apart, so that sweeps of consecutive sets
+  /// are further apart than max_time_offset).
+  ros::Time nextStamp() {
+    const ros::Time now = ros::Time::now();
+    last_stamp_ = std::max(now, last_stamp_ + ros::Duration(0.2));
+    return last_stamp_;
+  }
+
+  sensor_msgs::PointCloud2Ptr makeCloud(const SetSpec& spec, const ros::Time& stamp) const {
+    const auto& frame = frames_[spec.frame % frames_.size()];
+    const ros::Time cloud_stamp = stamp + ros::Duration(spec.cloud_offset);
+    switch (spec.cloud) {
+      case SetSpec::Cloud::kNone:
+        return nullptr;
+      case SetSpec::Cloud::kEmpty:
+        return lsf::test::cloudMsg({}, spec.cloud_frame, cloud_stamp);
+      case SetSpec::Cloud::kNaN: {
+        lsf::LidarCloud nan_cloud(500);
+        for (auto& p : nan_cloud) p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+        return lsf::test::cloudMsg(nan_cloud, spec.cloud_frame, cloud_stamp);
+      }
+      case SetSpec::Cloud::kNoRing:
+        return lsf::test::cloudMsg(frame.cloud, spec.cloud_frame, cloud_stamp, false);
+      case SetSpec::Cloud::kCustom: {
+        auto cloud = boost::make_shared<sensor_msgs::PointCloud2>(*spec.custom_cloud);
+        cloud->header.stamp = cloud_stamp;
+        return cloud;
+      }
+      case SetSpec::Cloud::kNormal:
+      default:
+        return lsf::test::cloudMsg(frame.cloud, spec.cloud_frame, cloud_stamp);
+    }
+  }
+
+  /// Publishes one input set stamped `stamp`.
+  void publishSet(const SetSpec& spec, const ros::Time& stamp) {
+    const auto& frame = frames_[spec.frame % frames_.size()];
+    const ros::Time right_stamp = stamp + ros::Duration(spec.right_stamp_offset);
+    auto left = lsf::test::imageMsg(frame.left, spec.left_encoding, kCameraFrame, stamp);
+    cv::Mat right_bgr = frame.right;
+    lsf::StereoCamera right_camera = frame.camera;
+    if (spec.right_width > 0) {
+      right_bgr = frame.right(cv::Rect(0, 0, spec.right_width, frame.right.rows)).clone();
+      right_camera.width = spec.right_width;
+    }
+    auto right = lsf::test::imageMsg(right_bgr, spec.right_encoding, kRightCameraFrame, right_stamp);
+    auto linfo = lsf::test::cameraInfoMsg(frame.camera, false, kCameraFrame, stamp);
+    auto rinfo = lsf::test::cameraInfoMsg(right_camera, true, kRightCameraFrame, right_stamp,
+                                          spec.positive_tx);
+    auto cloud = makeCloud(spec, stamp);
+    if (cloud && spec.cloud_first) cloud_.publish(cloud);
+    left_info_.publish(linfo);
+    right_info_.publish(rinfo);
+    left_image_.publish(left);
+    right_image_.publish(right);
+    if (cloud && !spec.cloud_first) cloud_.publish(cloud);
+  }
+
+  // --- outputs -----------------------------------------------------------------------------------
+  void subscribeOutputs(const std::vector<std::string>& names = kOutputs) {
+    for (const auto& name : names) {
+      const std::string topic = output(name);
+      if (name == "disparity") {
+        subs_.push_back(nh_.subscribe<stereo_msgs::DisparityImage>(
+            topic, 5, [this](const stereo_msgs::DisparityImageConstPtr& m) {
+              record("disparity", m->header, [&] { disparity_ = m; });
+            }));
+      } else if (name == "depth/camera_info") {
+        subs_.push_back(nh_.subscribe<sensor_msgs::CameraInfo>(
+            topic, 5, [this](const sensor_msgs::CameraInfoConstPtr& m) {
+              record("depth/camera_info", m->header, [&] { depth_info_ = m; });
+            }));
+      } else if (name == "points2") {
+        subs_.push_back(nh_.subscribe<sensor_msgs::PointCloud2>(
+            topic, 5, [this](const sensor_msgs::PointCloud2ConstPtr& m) {
+              record("points2", m->header, [&] { points_ = m; });
+            }));
+      } else if (name == "stats") {
+        subs_.push_back(nh_.subscribe<lsf::FusionStats>(
+            topic, 20, [this](const lsf::FusionStatsConstPtr& m) {
+              record("stats", m->header, [&] { stats_ = m; });
+            }));
+      } else {  // images
+        subs_.push_back(nh_.subscribe<sensor_msgs::Image>(
+            topic, 5, [this, name](const sensor_msgs::ImageConstPtr& m) {
+              record(name, m->header, [&] { images_[name] = m; });
+            }));
+      }
+    }
+  }
+  void unsubscribeOutputs() {
+    for (auto& s : subs_) s.shutdown();
+    subs_.clear();
+  }
+
+  /// Number of messages received on `name` stamped `stamp`.
+  int count(const std::string& name, const ros::Time& stamp) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = received_.find(name);
+    if (it == received_.end()) return 0;
+    const auto jt = it->second.find(stamp.toNSec());
+    return jt == it->second.end() ? 0 : jt->second;
+  }
+  /// True when every output got a message stamped `stamp` within `timeout`.
+  bool waitForOutputs(const ros::Time& stamp, double timeout = kOutputTimeout) {
+    return waitFor(timeout, [&] {
+      for (const auto& name : kOutputs) {
+        if (count(name, stamp) == 0) return false;
+      }
+      return true;
+    });
+  }
+  /// Number of outputs that got anything stamped `stamp` within `wait`.
+  int outputsAfter(const ros::Time& stamp, double wait = kNoOutputWait) {
+    ros::WallDuration(wait).sleep();
+    int n = 0;
+    for (const auto& name : kOutputs) n += count(name, stamp);
+    return n;
+  }
+  std::string frameId(const std::string& name) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return frame_ids_[name];
+  }
+  lsf::FusionStatsConstPtr stats() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return stats_;
+  }
+  stereo_msgs::DisparityImageConstPtr disparity() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return disparity_;
+  }
+  sensor_msgs::ImageConstPtr image(const std::string& name) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return images_[name];
+  }
+  sensor_msgs::CameraInfoConstPtr depthInfo() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return depth_info_;
+  }
+  sensor_msgs::PointCloud2ConstPtr points() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return points_;
+  }
+
+  // --- logs --------------------------------------------------------------------------------------
+  std::size_t logMark() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return logs_.size();
+  }
+  /// Waits for a WARN or ERROR logged after `mark` that contains every one of `parts`.
+  bool waitForLog(std::size_t mark, const std::vector<std::string>& parts, double timeout = 5.0) {
+    return waitFor(timeout, [&] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (std::size_t i = mark; i < logs_.size(); ++i) {
+        if (logs_[i].level < rosgraph_msgs::Log::WARN) continue;
+        bool all = true;
+        for (const auto& p : parts) all = all && logs_[i].msg.find(p) != std::string::npos;
+        if (all) return true;
+      }
+      return false;
+    });
+  }
+  std::string logsSince(std::size_t mark) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::string out;
+    for (std::size_t i = mark; i < logs_.size(); ++i) out += "\n  " + logs_[i].msg;
+    return out;
+  }
+
+  /// The process hosting the nodelet is registered with the master.
+  bool processAlive() {
+    std::vector<std::string> nodes;
+    if (!ros::master::getNodes(nodes)) return false;
+    return std::find(nodes.begin(), nodes.end(), process_node_) != nodes.end();
+  }
+
+  static bool waitFor(double timeout, const std::function<bool()>& condition) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout);
+    while (std::chrono::steady_clock::now() < end) {
+      if (condition()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return condition();
+  }
+
+ private:
+  template <class Store>
+  void record(const std::string& name, const std_msgs::Header& header, Store store) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++received_[name][header.stamp.toNSec()];
+    frame_ids_[name] = header.frame_id;
+    store();
+  }
+  void logCb(const rosgraph_msgs::LogConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    logs_.push_back(*msg);
+  }
+
+  ros::NodeHandle nh_, pnh_;
+  std::string process_node_, fusion_node_, ns_;
+  std::vector<lsf::sim::SyntheticFrame> frames_;
+  ros::Publisher left_image_, left_info_, right_image_, right_info_, cloud_;
+  tf2_ros::StaticTransformBroadcaster tf_broadcaster_;
+  std::vector<geometry_msgs::TransformStamped> tfs_;
+  ros::Subscriber rosout_;
+  std::vector<ros::Subscriber> subs_;
+  ros::Time last_stamp_;
+
+  std::mutex mutex_;
+  std::map<std::string, std::map<uint64_t, int>> received_;
+  std::map<std::string, std::string> frame_ids_;
+  stereo_msgs::DisparityImageConstPtr disparity_;
+  std::map<std::string, sensor_msgs::ImageConstPtr> images_;
+  sensor_msgs::CameraInfoConstPtr depth_info_;
+  sensor_msgs::PointCloud2ConstPtr points_;
+  lsf::FusionStatsConstPtr stats_;
+  std::vector<rosgraph_msgs::Log> logs_;
+};
+
+std::unique_ptr<Harness> harness;
+
+/// The fixture shares one Harness (and so one running nodelet) across the tests, in order.
+class FusionNode : public ::testing::Test {
+ protected:
+  Harness& h() { return *harness; }
+
+  /// After bad input: the process is alive and a good set still gives one output on every topic.
+  void expectStillProducing(const std::string& after) {
+    EXPECT_TRUE(h().processAlive()) << h().processNode() << " is gone after " << after;
+    const ros::Time stamp = h().nextStamp();
+    h().publishSet(SetSpec(), stamp);
+    EXPECT_TRUE(h().waitForOutputs(stamp)) << "no output for a good set after " << after;
+  }
+  /// Publishes a good set, waits for its outputs and returns the stats of it.
+  lsf::FusionStatsConstPtr goodSetStats() {
+    const ros::Time stamp = h().nextStamp();
+    h().publishSet(SetSpec(), stamp);
+    if (!h().waitForOutputs(stamp)) return nullptr;
+    return h().stats();
+  }
+};
+
+/// Median |depth - truth| / truth over pixels where both have a value, and the fraction of the
+/// pixels with truth that have a value.
+void depthError(const sensor_msgs::Image& depth, const cv::Mat1f& truth, double* median_rel,
+                double* coverage) {
+  std::vector<double> errors;
+  int with_truth = 0;
+  for (int r = 0; r < truth.rows; ++r) {
+    const float* row = reinterpret_cast<const float*>(&depth.data[r * depth.step]);
+    for (int c = 0; c < truth.cols; ++c) {
+      const float t = truth(r, c);
+      if (!(t > 0.f) || t > 60.f) continue;
+      ++with_truth;
+      if (std::isfinite(row[c])) errors.push_back(std::abs(row[c] - t) / t);
+    }
+  }
+  *coverage = with_truth > 0 ? static_cast<double>(errors.size()) / with_truth : 0.0;
+  if (errors.empty()) {
+    *median_rel = 1.0;
+    return;
+  }
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  *median_rel = errors[errors.size() / 2];
+}
+
+}  // namespace
+
+// -------------------------------------------------------------------------------------------------
+TEST_F(FusionNode, A_LazySubscription) {
+  // The nodelet is up once its outputs are advertised.
+  ASSERT_TRUE(Harness::waitFor(30.0, [&] {
+    ros::master::V_TopicInfo topics;
+    ros::master::getTopics(topics);
+    for (const auto& t : topics) {
+      if (t.name == h().output("stats")) return true;
+    }
+    return false;
+  })) << "the fusion outputs were never advertised";
+  ros::WallDuration(1.0).sleep();
+  EXPECT_TRUE(h().inputsSubscribed(false, 0.5)) << "inputs subscribed without output subscribers";
+
+  // Ask the master too: nobody subscribes to the left image.
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  ASSERT_TRUE(ros::master::execute("getSystemState", request, response, payload, true));
+  const XmlRpc::XmlRpcValue& subscribers = payload[1];
+  for (int i = 0; i < subscribers.size(); ++i) {
+    const std::string topic = static_cast<std::string>(subscribers[i][0]);
+    EXPECT_NE(topic, "/stereo/left/image_rect_color")
+        << "the master lists subscribers of the left image: " << subscribers[i].toXml();
+  }
+
+  // One subscriber on one output is enough; when it leaves, the inputs are dropped again.
+  for (const std::string output : {"stats", "depth", "points2"}) {
+    h().subscribeOutputs({output});
+    EXPECT_TRUE(h().inputsSubscribed(true, 10.0)) << "no input subscription for " << output;
+    h().unsubscribeOutputs();
+    EXPECT_TRUE(h().inputsSubscribed(false, 10.0)) << "inputs still subscribed after " << output;
+  }
+}
+
+TEST_F(FusionNode, B_OneOutputPerInputSetOnEveryTopic) {
+  h().subscribeOutputs();
+  ASSERT_TRUE(h().inputsSubscribed(true, 10.0));
+  const std::vector<std::string> encodings = {"bgr8", "bgra8", "rgb8", "rgba8", "mono8"};
+  uint32_t last_processed = 0;
+  for (std::size_t i = 0; i < encodings.size(); ++i) {
+    SetSpec spec;
+    spec.frame = static_cast<int>(i);
+    spec.left_encoding = spec.right_encoding = encodings[i];
+    spec.positive_tx = (i == 1);  // both sign conventions of the right P[3]
+    const ros::Time stamp = h().nextStamp();
+    h().publishSet(spec, stamp);
+    ASSERT_TRUE(h().waitForOutputs(stamp)) << "no complete output for " << encodings[i];
+    ros::WallDuration(0.3).sleep();  // duplicates would arrive now
+    for (const auto& name : kOutputs) {
+      EXPECT_EQ(h().count(name, stamp), 1) << name << " for " << encodings[i];
+      EXPECT_EQ(h().frameId(name), kCameraFrame) << name;
+    }
+    const auto& frame = h().frames()[i % h().frames().size()];
+
+    auto disparity = h().disparity();
+    EXPECT_NEAR(disparity->f, frame.camera.fx, 1e-3);
+    EXPECT_NEAR(disparity->T, frame.camera.baseline, 1e-6);
+    EXPECT_GT(disparity->min_disparity, 0.f);
+    EXPECT_GT(disparity->max_disparity, disparity->min_disparity);
+    EXPECT_GT(disparity->delta_d, 0.f);
+    EXPECT_EQ(disparity->image.encoding, sensor_msgs::image_encodings::TYPE_32FC1);
+    EXPECT_EQ(disparity->image.width, static_cast<uint32_t>(kWidth));
+    EXPECT_GT(disparity->valid_window.width, 0u);
+    EXPECT_LE(disparity->valid_window.x_offset + disparity->valid_window.width,
+              static_cast<uint32_t>(kWidth));
+
+    auto depth = h().image("depth");
+    ASSERT_TRUE(depth);
+    EXPECT_EQ(depth->encoding, sensor_msgs::image_encodings::TYPE_32FC1);
+    double median_rel = 1, coverage = 0;
+    depthError(*depth, frame.depth, &median_rel, &coverage);
+    EXPECT_LT(median_rel, 0.05) << "depth is off on the synthetic street (" << encodings[i] << ")";
+    EXPECT_GT(coverage, 0.5) << encodings[i];
+
+    auto info = h().depthInfo();
+    EXPECT_NEAR(info->P[0], frame.camera.fx, 1e-6);
+    EXPECT_EQ(info->width, static_cast<uint32_t>(kWidth));
+
+    auto points = h().points();
+    EXPECT_GT(points->width * points->height, 1000u);
+    std::set<std::string> fields;
+    for (const auto& f : points->fields) fields.insert(f.name);
+    EXPECT_EQ(fields, (std::set<std::string>{"x", "y", "z", "rgb"}));
+
+    auto prior = h().image("lidar_disparity");
+    int prior_pixels = 0;
+    for (std::size_t k = 0; k + 4 <= prior->data.size(); k += 4) {
+      float v;
+      std::memcpy(&v, &prior->data[k], 4);
+      prior_pixels += v > 0.f;
+    }
+    EXPECT_GT(prior_pixels, kWidth * kHeight / 5);
+
+    auto stats = h().stats();
+    EXPECT_EQ(stats->method, "fused_bi");
+    EXPECT_GT(stats->points_projected, 500);
+    EXPECT_EQ(stats->rings, 64);
+    EXPECT_FALSE(stats->rings_recovered);
+    EXPECT_GT(stats->processed_frames, last_processed);
+    EXPECT_GT(stats->total_ms, 0.f);
+    EXPECT_GT(stats->latency_ms, 0.f);
+    last_processed = stats->processed_frames;
+  }
+}
+
+TEST_F(FusionNode, C_SweepStampedAfterOrBeforeTheImages) {
+  // velodyne_pointcloud stamps a sweep at its last packet: after the image, sent after it.
+  SetSpec after;
+  after.cloud_offset = 0.08;
+  ros::Time stamp = h().nextStamp();
+  h().publishSet(after, stamp);
+  ASSERT_TRUE(h().waitForOutputs(stamp)) << "sweep stamped 80 ms after the images not matched";
+  ASSERT_TRUE(h().stats());
+  EXPECT_NEAR(h().stats()->sweep_time_offset, 0.08, 1e-3);
+
+  // Stamped before the images and sent first: matched after waiting for a later sweep.
+  SetSpec before;
+  before.cloud_offset = -0.05;
+  before.cloud_first = true;
+  stamp = h().nextStamp();
+  h().publishSet(before, stamp);
+  ASSERT_TRUE(h().waitForOutputs(stamp)) << "sweep stamped 50 ms before the images not matched";
+  EXPECT_NEAR(h().stats()->sweep_time_offset, -0.05, 1e-3);
+
+  // Beyond max_time_offset (0.1 s): skipped, with a warning, and counted.
+  const uint32_t unmatched = h().stats()->unmatched_frames;
+  SetSpec far;
+  far.cloud_offset = 0.15;
+  const std::size_t mark = h().logMark();
+  stamp = h().nextStamp();
+  h().publishSet(far, stamp);
+  EXPECT_EQ(h().outputsAfter(stamp), 0);
+  EXPECT_TRUE(h().waitForLog(mark, {"no sweep", "velodyne_points"})) << h().logsSince(mark);
+  auto stats = goodSetStats();
+  ASSERT_TRUE(stats);
+  EXPECT_GT(stats->unmatched_frames, unmatched);
+}
+
+TEST_F(FusionNode, D_MissingTfWarnsSkipsAndResumes) {
+  ASSERT_TRUE(h().stats()) << "needs the stats of earlier frames";
+  const uint32_t failures = h().stats()->tf_failures;
+  SetSpec late;
+  late.cloud_frame = "velodyne_late";
+  const std::size_t mark = h().logMark();
+  ros::Time stamp = h().nextStamp();
+  h().publishSet(late, stamp);
+  EXPECT_EQ(h().outputsAfter(stamp), 0) << "output without a transform";
+  EXPECT_TRUE(h().waitForLog(mark, {"velodyne_late", kCameraFrame, "stamp"}))
+      << "no warning naming both frames:" << h().logsSince(mark);
+  EXPECT_TRUE(h().processAlive());
+
+  // The transform appears: the same frame works.
+  h().addStaticTf(h().frames()[0].T_cam_lidar, "velodyne_late");
+  ros::WallDuration(0.5).sleep();
+  stamp = h().nextStamp();
+  h().publishSet(late, stamp);
+  ASSERT_TRUE(h().waitForOutputs(stamp)) << "no output once the transform is there";
+  EXPECT_GT(h().stats()->tf_failures, failures);
+}
+
+TEST_F(FusionNode, E_WrongEncodingIsRejected) {
+  ASSERT_TRUE(h().stats()) << "needs the stats of earlier frames";
+  const uint32_t invalid = h().stats()->invalid_inputs;
+  for (const std::string encoding : {"16UC1", "32FC1", "bayer_rggb8"}) {
+    SetSpec spec;
+    spec.left_encoding = encoding;
+    const std::size_t mark = h().logMark();
+    const ros::Time stamp = h().nextStamp();
+    h().publishSet(spec, stamp);
+    EXPECT_EQ(h().outputsAfter(stamp), 0) << encoding;
+    EXPECT_TRUE(h().waitForLog(mark, {"left/image_rect_color", encoding}))
+        << encoding << ":" << h().logsSince(mark);
+    expectStillProducing("a " + encoding + " image");
+  }
+  EXPECT_GE(h().stats()->invalid_inputs, invalid + 3);
+}
+
+TEST_F(FusionNode, F_MismatchedImageSizesAreRejected) {
+  SetSpec spec;
+  spec.right_width = kWidth / 2;
+  const std::size_t mark = h().logMark();
+  const ros::Time stamp = h().nextStamp();
+  h().publishSet(spec, stamp);
+  EXPECT_EQ(h().outputsAfter(stamp), 0);
+  EXPECT_TRUE(h().waitForLog(mark, {"right/image_rect_color", "160x120", "320x120"}))
+      << h().logsSince(mark);
+  expectStillProducing("images of different sizes");
+}
+
+TEST_F(FusionNode, G_EmptyAndNanCloudsAreRejected) {
+  SetSpec empty;
+  empty.cloud = SetSpec::Cloud::kEmpty;
+  std::size_t mark = h().logMark();
+  ros::Time stamp = h().nextStamp();
+  h().publishSet(empty, stamp);
+  EXPECT_EQ(h().outputsAfter(stamp), 0);
+  EXPECT_TRUE(h().waitForLog(mark, {"velodyne_points", "empty"})) << h().logsSince(mark);
+  expectStillProducing("an empty cloud");
+
+  SetSpec nan;
+  nan.cloud = SetSpec::Cloud::kNaN;
+  mark = h().logMark();
+  stamp = h().nextStamp();
+  h().publishSet(nan, stamp);
+  EXPECT_EQ(h().outputsAfter(stamp), 0);
+  EXPECT_TRUE(h().waitForLog(mark, {"velodyne_points", "finite"})) << h().logsSince(mark);
+  expectStillProducing("an all-NaN cloud");
+}
+
+TEST_F(FusionNode, H_OutOfOrderStampsAreDroppedAndCounted) {
+  ASSERT_TRUE(h().stats()) << "needs the stats of earlier frames";
+  const uint32_t out_of_order = h().stats()->out_of_order;
+  const ros::Time newer = h().nextStamp();
+  h().publishSet(SetSpec(), newer);
+  ASSERT_TRUE(h().waitForOutputs(newer));
+  const ros::Time older = newer - ros::Duration(0.1);
+  const std::size_t mark = h().logMark();
+  h().publishSet(SetSpec(), older);
+  EXPECT_EQ(h().outputsAfter(older), 0) << "an older set was processed after a newer one";
+  EXPECT_TRUE(h().waitForLog(mark, {"out of order"})) << h().logsSince(mark);
+  auto stats = goodSetStats();
+  ASSERT_TRUE(stats);
+  EXPECT_GE(stats->out_of_order, out_of_order + 2) << "image set and sweep both count";
+}
+
+TEST_F(FusionNode, I_CloudWithoutRingFieldGetsRingsByElevation) {
+  SetSpec spec;
+  spec.cloud = SetSpec::Cloud::kNoRing;
+  const ros::Time stamp = h().nextStamp();
+  h().publishSet(spec, stamp);
+  ASSERT_TRUE(h().waitForOutputs(stamp));
+  auto stats = h().stats();
+  EXPECT_TRUE(stats->rings_recovered);
+  EXPECT_GT(stats->rings, 8);
+  EXPECT_LE(stats->rings, 64);  // ~num_rings
+  EXPECT_GT(stats->points_projected, 500);
+}
+
+TEST_F(FusionNode, J_RealLuminarCloudWithoutRingField) {
+  LSF_REQUIRE_DATA("bag_luminar/test.bag");
+  rosbag::Bag bag(lsf::test::dataPath("bag_luminar/test.bag"));
+  rosbag::View view(bag, rosbag::TopicQuery("/luminar_pointcloud"));
+  std::vector<sensor_msgs::PointCloud2Ptr> clouds;
+  for (const rosbag::MessageInstance& m : view) {
+    auto cloud = m.instantiate<sensor_msgs::PointCloud2>();
+    if (cloud) clouds.push_back(boost::make_shared<sensor_msgs::PointCloud2>(*cloud));
+  }
+  ASSERT_EQ(clouds.size(), 5u);
+  const std::string frame = clouds[0]->header.frame_id;
+  ASSERT_FALSE(frame.empty());
+  // The Luminar looks along its x axis like a Velodyne: mount it where the synthetic LiDAR is.
+  h().addStaticTf(h().frames()[0].T_cam_lidar, frame);
+  ros::WallDuration(0.5).sleep();
+  for (std::size_t i = 0; i < clouds.size(); ++i) {
+    int finite = 0;
+    for (sensor_msgs::PointCloud2ConstIterator<float> x(*clouds[i], "x"), y(*clouds[i], "y"),
+         z(*clouds[i], "z");
+         x != x.end(); ++x, ++y, ++z) {
+      finite += std::isfinite(*x) && std::isfinite(*y) && std::isfinite(*z);
+    }
+    SetSpec spec;
+    spec.cloud = SetSpec::Cloud::kCustom;
+    spec.custom_cloud = clouds[i];
+    const ros::Time stamp = h().nextStamp();
+    h().publishSet(spec, stamp);
+    ASSERT_TRUE(h().waitForOutputs(stamp)) << "Luminar cloud " << i;
+    auto stats = h().stats();
+    EXPECT_TRUE(stats->rings_recovered);
+    EXPECT_EQ(stats->points_in_cloud, finite);
+    EXPECT_GT(stats->points_projected, 0);
+  }
+}
+
+TEST_F(FusionNode, K_ParametersChangeLiveAndInvalidOnesAreRejected) {
+  const std::string service = h().fusionNode() + "/set_parameters";
+  ASSERT_TRUE(ros::service::waitForService(service, 5000));
+  auto set = [&](const std::function<void(dynamic_reconfigure::Config&)>& fill,
+                 dynamic_reconfigure::Config* result) {
+    dynamic_reconfigure::Reconfigure srv;
+    fill(srv.request.config);
+    const bool ok = ros::service::call(service, srv);
+    if (result) *result = srv.response.config;
+    return ok;
+  };
+  auto value = [](const dynamic_reconfigure::Config& c, const std::string& name) {
+    for (const auto& d : c.doubles) {
+      if (d.name == name) return d.value;
+    }
+    return std::nan("");
+  };
+
+  // alpha + beta + gamma != 1: rejected with an error naming the parameter, old values kept.
+  std::size_t mark = h().logMark();
+  dynamic_reconfigure::Config result;
+  ASSERT_TRUE(set(
+      [](dynamic_reconfigure::Config& c) {
+        dynamic_reconfigure::DoubleParameter p;
+        p.name = "patchmatch_alpha";
+        p.value = 0.5;
+        c.doubles.push_back(p);
+      },
+      &result));
+  EXPECT_DOUBLE_EQ(value(result, "patchmatch_alpha"), 0.1);
+  EXPECT_TRUE(h().waitForLog(mark, {"patchmatch/alpha"})) << h().logsSince(mark);
+  auto stats = goodSetStats();
+  ASSERT_TRUE(stats);
+  EXPECT_EQ(stats->method, "fused_bi");
+  double alpha = 0;
+  ros::param::get(h().fusionNode() + "/patchmatch/alpha", alpha);
+  EXPECT_DOUBLE_EQ(alpha, 0.1);
+
+  // A valid change applies to the next frame.
+  ASSERT_TRUE(set(
+      [](dynamic_reconfigure::Config& c) {
+        dynamic_reconfigure::StrParameter p;
+        p.name = "method";
+        p.value = "lidar_bi";
+        c.strs.push_back(p);
+      },
+      nullptr));
+  stats = goodSetStats();
+  ASSERT_TRUE(stats);
+  EXPECT_EQ(stats->method, "lidar_bi");
+  std::string method;
+  ros::param::get(h().fusionNode() + "/method", method);
+  EXPECT_EQ(method, "lidar_bi");
+
+  ASSERT_TRUE(set(
+      [](dynamic_reconfigure::Config& c) {
+        dynamic_reconfigure::StrParameter p;
+        p.name = "method";
+        p.value = "fused_bi";
+        c.strs.push_back(p);
+      },
+      nullptr));
+  stats = goodSetStats();
+  ASSERT_TRUE(stats);
+  EXPECT_EQ(stats->method, "fused_bi");
+}
+
+TEST_F(FusionNode, L_DiagnosticsReportRateAndProcessingTime) {
+  ros::NodeHandle nh;
+  std::mutex m;
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> seen;
+  auto sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(m);
+        for (const auto& s : msg->status) seen[s.name] = s;
+      });
+  // Keep frames coming so the rate is measured.
+  const auto has = [&](const std::string& suffix) {
+    std::lock_guard<std::mutex> lock(m);
+    for (const auto& kv : seen) {
+      if (kv.first.size() >= suffix.size() &&
+          kv.first.compare(kv.first.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        return true;
+      }
+    }
+    return false;
+  };
+  for (int i = 0; i < 15 && !(has(": output") && has(": processing")); ++i) {
+    const ros::Time stamp = h().nextStamp();
+    h().publishSet(SetSpec(), stamp);
+    h().waitForOutputs(stamp);
+  }
+  ASSERT_TRUE(has(": output"));
+  ASSERT_TRUE(has(": processing"));
+  std::lock_guard<std::mutex> lock(m);
+  for (const auto& kv : seen) {
+    if (kv.first.find(": processing") == std::string::npos) continue;
+    bool has_time = false;
+    for (const auto& v : kv.second.values) has_time = has_time || v.key == "processing time mean [ms]";
+    EXPECT_TRUE(has_time);
+  }
+}
+
+// Only in fusion_approx_sync.test: right image and info stamped 4 ms after the left ones.
+TEST_F(FusionNode, Approx_SetsWithDifferentStampsAreMatched) {
+  h().subscribeOutputs();
+  ASSERT_TRUE(h().inputsSubscribed(true, 10.0));
+  std::vector<ros::Time> stamps;
+  for (int i = 0; i < 10; ++i) {
+    SetSpec spec;
+    spec.frame = i;
+    spec.right_stamp_offset = 0.004;
+    const ros::Time stamp = h().nextStamp();
+    stamps.push_back(stamp);
+    h().publishSet(spec, stamp);
+    ros::WallDuration(0.25).sleep();
+  }
+  // ApproximateTime may hold the newest set until the next message shows it is the best match.
+  int complete = 0;
+  for (const auto& stamp : stamps) complete += h().waitForOutputs(stamp, 3.0);
+  EXPECT_GE(complete, 7) << "of 10 sets";
+  for (const auto& stamp : stamps) {
+    EXPECT_EQ(h().count("depth", stamp + ros::Duration(0.004)), 0)
+        << "output stamped with the right image, not the left";
+  }
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_fusion_node");
+  ros::AsyncSpinner spinner(3);
+  spinner.start();
+  harness = std::make_unique<Harness>();
+  const int result = RUN_ALL_TESTS();
+  harness.reset();
+  spinner.stop();
+  ros::shutdown();
+  return result;
+}

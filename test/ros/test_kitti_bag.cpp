@@ -1,0 +1,486 @@
+// rostest (test/ros/kitti_bag.test): real KITTI data through kitti_to_bag and the fusion nodelet.
+//
+//  1. kitti_to_bag on the whole sample drive: the bag holds one message per topic for every frame
+//     with both images and a sweep (and none for the LiDAR-only frames), with the stamps of the
+//     KITTI timestamp files, the frames, encodings, fields and calibration the rig uses; bad
+//     input gives a non-zero exit status and no bag.
+//  2. A 3-frame drive (symbolic links into the data, in the build folder) is converted, and the
+//     bag is published frame by frame to the nodelet started by the launch file: every input set
+//     yields exactly one message on each output, stamped with the left image stamp in the left
+//     optical frame, and the depth equals the offline kitti_runner's depth PNG of the same frame
+//     within the PNG's quantisation.
+// Missing data fails under CI=true and skips otherwise.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <cv_bridge/cv_bridge.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <stereo_msgs/DisparityImage.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "data/data_guard.h"
+#include "lidar_stereo_fusion/FusionStats.h"
+#include "lidar_stereo_fusion/io/kitti.h"
+
+namespace fs = std::filesystem;
+namespace kitti = lidar_stereo_fusion::kitti;
+
+namespace {
+
+const char kDate[] = "kitti_raw/2011_09_26";
+const char kDrive[] = "2011_09_26_drive_0009_sync";
+const char kLeftFrame[] = "left_camera_optical_frame";
+const std::vector<std::string> kReplayFrames = {"0000000000", "0000000005", "0000000010"};
+/// Seconds to wait for the outputs of one frame (the pipeline takes a few seconds per frame on
+/// two cores; a frame that never comes out fails the test long before rostest's time limit).
+constexpr double kFrameTimeout = 240.0;
+
+/// Exit status and output (stdout + stderr) of a shell command.
+std::pair<int, std::string> run(const std::string& command) {
+  std::string output;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return {-1, "popen failed"};
+  std::array<char, 512> buffer{};
+  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+std::string scratchDir() {
+  const fs::path dir = fs::path(LSF_BINARY_DIR) / "test_kitti_bag";
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+/// A KITTI raw date folder in the build tree whose drive holds only `frames`: symbolic links to
+/// the shared data (nothing is copied). Returns the drive folder.
+std::string makeSubsetDrive(const std::vector<std::string>& frames) {
+  const fs::path src_date = lidar_stereo_fusion::test::dataPath(kDate);
+  const fs::path src = src_date / kDrive;
+  const fs::path date = fs::path(scratchDir()) / "subset" / "2011_09_26";
+  const fs::path drive = date / kDrive;
+  fs::remove_all(date);
+  for (const char* calib : {"calib_cam_to_cam.txt", "calib_velo_to_cam.txt"}) {
+    fs::create_directories(date);
+    fs::create_symlink(src_date / calib, date / calib);
+  }
+  for (const std::string sensor : {"image_02", "image_03", "velodyne_points"}) {
+    fs::create_directories(drive / sensor / "data");
+    for (const auto& entry : fs::directory_iterator(src / sensor)) {
+      if (entry.path().extension() == ".txt") {
+        fs::create_symlink(entry.path(), drive / sensor / entry.path().filename());
+      }
+    }
+    const std::string ext = sensor == "velodyne_points" ? ".bin" : ".png";
+    for (const std::string& frame : frames) {
+      fs::create_symlink(src / sensor / "data" / (frame + ext),
+                         drive / sensor / "data" / (frame + ext));
+    }
+  }
+  return drive.string();
+}
+
+/// Every message of `bag`, grouped by topic, in time order.
+std::map<std::string, std::vector<rosbag::MessageInstance>> readBag(const std::string& path,
+                                                                     rosbag::Bag& bag) {
+  bag.open(path, rosbag::bagmode::Read);
+  std::map<std::string, std::vector<rosbag::MessageInstance>> by_topic;
+  rosbag::View view(bag);
+  for (const rosbag::MessageInstance& m : view) by_topic[m.getTopic()].push_back(m);
+  return by_topic;
+}
+
+/// Stamp [s] of `frame` in a KITTI timestamps file (line = frame number).
+double kittiStamp(const std::string& file, const std::string& frame) {
+  const std::vector<double> stamps = kitti::readTimestamps(file);
+  const size_t index = std::stoul(frame);
+  return index < stamps.size() ? stamps[index] : -1.0;
+}
+
+/// The messages received on the fusion outputs, keyed by header stamp.
+class OutputCollector {
+ public:
+  explicit OutputCollector(ros::NodeHandle& nh) {
+    subs_.push_back(subscribe<stereo_msgs::DisparityImage>(nh, "disparity", &disparity_));
+    subs_.push_back(subscribe<sensor_msgs::Image>(nh, "depth", &depth_));
+    subs_.push_back(subscribe<sensor_msgs::CameraInfo>(nh, "depth/camera_info", &depth_info_));
+    subs_.push_back(subscribe<sensor_msgs::PointCloud2>(nh, "points2", &points_));
+    subs_.push_back(subscribe<sensor_msgs::Image>(nh, "lidar_disparity", &lidar_disparity_));
+    subs_.push_back(subscribe<lidar_stereo_fusion::FusionStats>(nh, "stats", &stats_));
+  }
+
+  /// Waits until every output has a message stamped `stamp`.
+  bool waitForAll(const ros::Time& stamp, double timeout_s) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                        [&] { return complete(stamp); });
+  }
+
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::map<ros::Time, std::vector<stereo_msgs::DisparityImage::ConstPtr>> disparity_;
+  std::map<ros::Time, std::vector<sensor_msgs::Image::ConstPtr>> depth_;
+  std::map<ros::Time, std::vector<sensor_msgs::CameraInfo::ConstPtr>> depth_info_;
+  std::map<ros::Time, std::vector<sensor_msgs::PointCloud2::ConstPtr>> points_;
+  std::map<ros::Time, std::vector<sensor_msgs::Image::ConstPtr>> lidar_disparity_;
+  std::map<ros::Time, std::vector<lidar_stereo_fusion::FusionStats::ConstPtr>> stats_;
+
+ private:
+  template <class Msg>
+  ros::Subscriber subscribe(ros::NodeHandle& nh, const std::string& topic,
+                            std::map<ros::Time, std::vector<typename Msg::ConstPtr>>* store) {
+    return nh.subscribe<Msg>(topic, 10, [this, store](const typename Msg::ConstPtr& msg) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        (*store)[msg->header.stamp].push_back(msg);
+      }
+      cv_.notify_all();
+    });
+  }
+
+  bool complete(const ros::Time& t) const {
+    return disparity_.count(t) && depth_.count(t) && depth_info_.count(t) && points_.count(t) &&
+           lidar_disparity_.count(t) && stats_.count(t);
+  }
+
+  std::vector<ros::Subscriber> subs_;
+};
+
+template <class Map>
+size_t messageCount(const Map& map) {
+  size_t n = 0;
+  for (const auto& kv : map) n += kv.second.size();
+  return n;
+}
+
+}  // namespace
+
+TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
+  LSF_REQUIRE_DATA(std::string(kDate) + "/" + kDrive);
+  const std::string date = lidar_stereo_fusion::test::dataPath(kDate);
+  const std::string drive = date + "/" + kDrive;
+  const std::string bag_path = scratchDir() + "/whole_drive.bag";
+  fs::remove(bag_path);
+  const auto [status, output] =
+      run(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + drive + " --out " + bag_path);
+  ASSERT_EQ(status, 0) << output;
+  // The LiDAR-only frames are named as skipped.
+  EXPECT_NE(output.find("0000000016"), std::string::npos) << output;
+
+  const std::vector<kitti::Frame> frames = kitti::listFrames(drive);
+  ASSERT_EQ(frames.size(), 11u);
+  const kitti::Calibration calib = kitti::readCalibration(date);
+  rosbag::Bag bag;
+  auto topics = readBag(bag_path, bag);
+  ASSERT_EQ(topics.size(), 6u);
+  for (const char* topic : {"/stereo/left/image_rect_color", "/stereo/left/camera_info",
+                            "/stereo/right/image_rect_color", "/stereo/right/camera_info",
+                            "/velodyne_points"}) {
+    EXPECT_EQ(topics[topic].size(), frames.size()) << topic;
+  }
+  ASSERT_EQ(topics["/tf_static"].size(), 1u);
+  ASSERT_EQ(topics["/velodyne_points"].size(), frames.size());
+  ASSERT_EQ(topics["/stereo/left/image_rect_color"].size(), frames.size());
+
+  // /tf_static: latched on replay, velodyne -> left (T_cam_velo^-1), left -> right (+B in x).
+  const auto& tf_instance = topics["/tf_static"].front();
+  ASSERT_TRUE(tf_instance.getConnectionHeader());
+  EXPECT_EQ(tf_instance.getConnectionHeader()->at("latching"), "1");
+  const auto tf = tf_instance.instantiate<tf2_msgs::TFMessage>();
+  ASSERT_TRUE(tf);
+  ASSERT_EQ(tf->transforms.size(), 2u);
+  EXPECT_EQ(tf->transforms[0].header.frame_id, "velodyne");
+  EXPECT_EQ(tf->transforms[0].child_frame_id, kLeftFrame);
+  const Eigen::Vector3d camera_in_velodyne = calib.T_cam_velo.inverse().translation();
+  EXPECT_NEAR(tf->transforms[0].transform.translation.x, camera_in_velodyne.x(), 1e-9);
+  EXPECT_NEAR(tf->transforms[0].transform.translation.y, camera_in_velodyne.y(), 1e-9);
+  EXPECT_NEAR(tf->transforms[0].transform.translation.z, camera_in_velodyne.z(), 1e-9);
+  EXPECT_EQ(tf->transforms[1].header.frame_id, kLeftFrame);
+  EXPECT_EQ(tf->transforms[1].child_frame_id, "right_camera_optical_frame");
+  EXPECT_NEAR(tf->transforms[1].transform.translation.x, calib.camera.baseline, 1e-9);
+
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const std::string& name = frames[i].name;
+    SCOPED_TRACE("frame " + name);
+    const auto left = topics["/stereo/left/image_rect_color"][i].instantiate<sensor_msgs::Image>();
+    const auto right = topics["/stereo/right/image_rect_color"][i].instantiate<sensor_msgs::Image>();
+    const auto left_info = topics["/stereo/left/camera_info"][i].instantiate<sensor_msgs::CameraInfo>();
+    const auto right_info =
+        topics["/stereo/right/camera_info"][i].instantiate<sensor_msgs::CameraInfo>();
+    const auto cloud = topics["/velodyne_points"][i].instantiate<sensor_msgs::PointCloud2>();
+    ASSERT_TRUE(left && right && left_info && right_info && cloud);
+
+    // Stamps from the KITTI files: one stamp for the stereo pair, the sweep end for the cloud.
+    const double image_stamp = kittiStamp(drive + "/image_02/timestamps.txt", name);
+    const double sweep_end = kittiStamp(drive + "/velodyne_points/timestamps_end.txt", name);
+    EXPECT_NEAR(left->header.stamp.toSec(), image_stamp, 1e-6);
+    EXPECT_EQ(right->header.stamp, left->header.stamp);
+    EXPECT_EQ(left_info->header.stamp, left->header.stamp);
+    EXPECT_EQ(right_info->header.stamp, left->header.stamp);
+    EXPECT_NEAR(cloud->header.stamp.toSec(), sweep_end, 1e-6);
+    const double offset = (cloud->header.stamp - left->header.stamp).toSec();
+    EXPECT_GT(offset, 0.0);  // near, not equal
+    EXPECT_LT(offset, 0.1);
+    EXPECT_EQ(topics["/velodyne_points"][i].getTime(), cloud->header.stamp);
+
+    EXPECT_EQ(left->header.frame_id, kLeftFrame);
+    EXPECT_EQ(left_info->header.frame_id, kLeftFrame);
+    EXPECT_EQ(right->header.frame_id, "right_camera_optical_frame");
+    EXPECT_EQ(right_info->header.frame_id, "right_camera_optical_frame");
+    EXPECT_EQ(cloud->header.frame_id, "velodyne");
+    EXPECT_EQ(left->encoding, "bgr8");
+    EXPECT_EQ(right->encoding, "bgr8");
+    EXPECT_EQ(left->width, 1242u);
+    EXPECT_EQ(left->height, 375u);
+    EXPECT_EQ(left_info->width, left->width);
+    EXPECT_EQ(left_info->height, left->height);
+    // Pixels are the PNG's (BGR order).
+    if (i == 0) {
+      const cv::Mat png = cv::imread(frames[i].left_image, cv::IMREAD_COLOR);
+      const cv::Mat msg_image = cv_bridge::toCvShare(left)->image;
+      EXPECT_EQ(cv::norm(png, msg_image, cv::NORM_INF), 0.0);
+    }
+    // Rectified pair: right P has Tx = -fx * B.
+    EXPECT_DOUBLE_EQ(left_info->P[0], calib.camera.fx);
+    EXPECT_DOUBLE_EQ(left_info->P[3], 0.0);
+    EXPECT_NEAR(right_info->P[3], -calib.camera.fx * calib.camera.baseline, 1e-9);
+    EXPECT_NEAR(-right_info->P[3] / right_info->P[0], 0.5327, 1e-3);
+
+    // Cloud: every point of the .bin, fields with the types of velodyne_pointcloud.
+    const kitti::Frame& f = frames[i];
+    const auto points = kitti::readVelodyneBin(f.velodyne);
+    ASSERT_EQ(cloud->width * cloud->height, points.size());
+    std::map<std::string, uint8_t> types;
+    for (const auto& field : cloud->fields) types[field.name] = field.datatype;
+    using sensor_msgs::PointField;
+    EXPECT_EQ(types["x"], PointField::FLOAT32);
+    EXPECT_EQ(types["intensity"], PointField::FLOAT32);
+    EXPECT_EQ(types["ring"], PointField::UINT16);
+    EXPECT_EQ(types["time"], PointField::FLOAT32);
+    sensor_msgs::PointCloud2ConstIterator<float> x(*cloud, "x"), intensity(*cloud, "intensity"),
+        time(*cloud, "time");
+    sensor_msgs::PointCloud2ConstIterator<uint16_t> ring(*cloud, "ring");
+    std::set<uint16_t> rings;
+    float min_time = 1.f, max_time = -1.f;
+    for (size_t k = 0; k < points.size(); ++k, ++x, ++intensity, ++time, ++ring) {
+      if (x[0] != points[k].x || x[1] != points[k].y || x[2] != points[k].z ||
+          *intensity != points[k].intensity) {
+        ADD_FAILURE() << "point " << k << " differs from the .bin";
+        break;
+      }
+      rings.insert(*ring);
+      min_time = std::min(min_time, *time);
+      max_time = std::max(max_time, *time);
+    }
+    EXPECT_EQ(rings.size(), 64u);
+    EXPECT_EQ(*rings.rbegin(), 63);
+    // Stamped at the sweep end: point times span the previous revolution (~0.1 s), up to 0.
+    EXPECT_LE(max_time, 0.f);
+    EXPECT_GT(max_time, -0.01f);
+    EXPECT_LT(min_time, -0.09f);
+    EXPECT_GT(min_time, -0.11f);
+  }
+  bag.close();
+  fs::remove(bag_path);  // 60 MB
+}
+
+TEST(KittiToBag, BadInputFailsWithoutWritingABag) {
+  const std::string bag_path = scratchDir() + "/bad.bag";
+  fs::remove(bag_path);
+  auto [status, output] = run(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + scratchDir() +
+                              "/no_such_drive --out " + bag_path);
+  EXPECT_EQ(status, 1) << output;
+  EXPECT_NE(output.find("no_such_drive"), std::string::npos) << output;
+  std::tie(status, output) = run(std::string(LSF_KITTI_TO_BAG) + " --out " + bag_path);
+  EXPECT_EQ(status, 2) << output;
+  EXPECT_NE(output.find("--kitti-raw"), std::string::npos) << output;
+  std::tie(status, output) =
+      run(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw x --out " + bag_path + " --frames -3");
+  EXPECT_EQ(status, 2) << output;
+  EXPECT_FALSE(fs::exists(bag_path));
+  EXPECT_FALSE(fs::exists(bag_path + ".partial"));
+}
+
+TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner) {
+  LSF_REQUIRE_DATA(std::string(kDate) + "/" + kDrive);
+  const std::string drive = makeSubsetDrive(kReplayFrames);
+  const std::string bag_path = scratchDir() + "/replay.bag";
+  fs::remove(bag_path);
+  const auto [status, output] =
+      run(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + drive + " --out " + bag_path);
+  ASSERT_EQ(status, 0) << output;
+
+  rosbag::Bag bag;
+  auto topics = readBag(bag_path, bag);
+  const auto& lefts = topics["/stereo/left/image_rect_color"];
+  ASSERT_EQ(lefts.size(), kReplayFrames.size());
+
+  ros::NodeHandle nh;
+  ros::NodeHandle fusion_nh("fusion");
+  OutputCollector outputs(fusion_nh);
+  ros::Publisher tf_pub = nh.advertise<tf2_msgs::TFMessage>("/tf_static", 1, /*latch=*/true);
+  tf_pub.publish(topics["/tf_static"].front().instantiate<tf2_msgs::TFMessage>());
+  std::map<std::string, ros::Publisher> inputs;
+  for (const char* topic : {"/stereo/left/image_rect_color", "/stereo/right/image_rect_color"}) {
+    inputs[topic] = nh.advertise<sensor_msgs::Image>(topic, 5);
+  }
+  for (const char* topic : {"/stereo/left/camera_info", "/stereo/right/camera_info"}) {
+    inputs[topic] = nh.advertise<sensor_msgs::CameraInfo>(topic, 5);
+  }
+  inputs["/velodyne_points"] = nh.advertise<sensor_msgs::PointCloud2>("/velodyne_points", 5);
+
+  // The nodelet subscribes lazily: our output subscriptions make it subscribe to the inputs.
+  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(60.0);
+  auto connected = [&] {
+    for (const auto& kv : inputs) {
+      if (kv.second.getNumSubscribers() == 0) return false;
+    }
+    return true;
+  };
+  while (!connected() && ros::WallTime::now() < give_up) ros::WallDuration(0.1).sleep();
+  ASSERT_TRUE(connected()) << "the fusion nodelet did not subscribe to the bag's topics";
+
+  // Frame by frame: sweep, then the image set, then wait for every output of that frame.
+  std::vector<ros::Time> stamps;
+  for (size_t i = 0; i < lefts.size(); ++i) {
+    const auto left = lefts[i].instantiate<sensor_msgs::Image>();
+    stamps.push_back(left->header.stamp);
+    inputs["/velodyne_points"].publish(
+        topics["/velodyne_points"][i].instantiate<sensor_msgs::PointCloud2>());
+    inputs["/stereo/left/camera_info"].publish(
+        topics["/stereo/left/camera_info"][i].instantiate<sensor_msgs::CameraInfo>());
+    inputs["/stereo/right/camera_info"].publish(
+        topics["/stereo/right/camera_info"][i].instantiate<sensor_msgs::CameraInfo>());
+    inputs["/stereo/right/image_rect_color"].publish(
+        topics["/stereo/right/image_rect_color"][i].instantiate<sensor_msgs::Image>());
+    inputs["/stereo/left/image_rect_color"].publish(left);
+    const ros::WallTime start = ros::WallTime::now();
+    ASSERT_TRUE(outputs.waitForAll(left->header.stamp, kFrameTimeout))
+        << "frame " << kReplayFrames[i] << ": not every output came within " << kFrameTimeout
+        << " s";
+    std::printf("frame %s: outputs after %.1f s\n", kReplayFrames[i].c_str(),
+                (ros::WallTime::now() - start).toSec());
+  }
+  ros::WallDuration(1.0).sleep();  // anything extra would arrive now
+
+  // The offline runner on the same three frames.
+  const std::string runner_out = scratchDir() + "/runner";
+  fs::remove_all(runner_out);
+  const auto [runner_status, runner_output] = run(std::string(LSF_KITTI_RUNNER) + " --kitti-raw " +
+                                                  drive + " --out " + runner_out);
+  ASSERT_EQ(runner_status, 0) << runner_output;
+
+  std::lock_guard<std::mutex> lock(outputs.mutex_);
+  EXPECT_EQ(messageCount(outputs.disparity_), stamps.size());
+  EXPECT_EQ(messageCount(outputs.depth_), stamps.size());
+  EXPECT_EQ(messageCount(outputs.depth_info_), stamps.size());
+  EXPECT_EQ(messageCount(outputs.points_), stamps.size());
+  EXPECT_EQ(messageCount(outputs.lidar_disparity_), stamps.size());
+  EXPECT_EQ(messageCount(outputs.stats_), stamps.size());
+
+  const auto left_info = topics["/stereo/left/camera_info"].front().instantiate<sensor_msgs::CameraInfo>();
+  const double fx = left_info->P[0];
+  const double baseline =
+      -topics["/stereo/right/camera_info"].front().instantiate<sensor_msgs::CameraInfo>()->P[3] / fx;
+  for (size_t i = 0; i < stamps.size(); ++i) {
+    const ros::Time& t = stamps[i];
+    SCOPED_TRACE("frame " + kReplayFrames[i]);
+    const auto cloud = topics["/velodyne_points"][i].instantiate<sensor_msgs::PointCloud2>();
+    const auto& disparity = outputs.disparity_[t].front();
+    const auto& depth = outputs.depth_[t].front();
+    const auto& depth_info = outputs.depth_info_[t].front();
+    const auto& points = outputs.points_[t].front();
+    const auto& prior = outputs.lidar_disparity_[t].front();
+    const auto& stats = outputs.stats_[t].front();
+    for (const std::string& frame_id :
+         {disparity->header.frame_id, disparity->image.header.frame_id, depth->header.frame_id,
+          depth_info->header.frame_id, points->header.frame_id, prior->header.frame_id,
+          stats->header.frame_id}) {
+      EXPECT_EQ(frame_id, kLeftFrame);
+    }
+    EXPECT_EQ(disparity->image.header.stamp, t);
+    EXPECT_EQ(depth->encoding, "32FC1");
+    EXPECT_EQ(prior->encoding, "32FC1");
+    EXPECT_EQ(disparity->image.encoding, "32FC1");
+    EXPECT_EQ(depth->width, 1242u);
+    EXPECT_EQ(depth->height, 375u);
+    EXPECT_EQ(depth_info->P, left_info->P);
+    EXPECT_NEAR(disparity->f, fx, 1e-6);
+    EXPECT_NEAR(disparity->T, baseline, 1e-6);
+    EXPECT_GT(points->width * points->height, 10000u);
+    EXPECT_EQ(stats->points_in_cloud, static_cast<int>(cloud->width));
+    EXPECT_EQ(stats->rings, 64);
+    EXPECT_FALSE(stats->rings_recovered);
+    EXPECT_NEAR(stats->sweep_time_offset, (cloud->header.stamp - t).toSec(), 1e-4);
+    EXPECT_EQ(stats->processed_frames, i + 1);
+    EXPECT_EQ(stats->dropped_frames + stats->unmatched_frames + stats->tf_failures +
+                  stats->invalid_inputs + stats->out_of_order + stats->processing_errors,
+              0u);
+
+    // Depth against disparity (z = f B / d) and against the offline runner's PNG.
+    const cv::Mat1f z_ros = cv_bridge::toCvShare(depth)->image;
+    const cv::Mat1f d_ros = cv_bridge::toCvShare(disparity->image, disparity)->image;
+    const cv::Mat1f z_runner =
+        kitti::readDepthPng(runner_out + "/" + kReplayFrames[i] + ".png");
+    ASSERT_EQ(z_runner.size(), z_ros.size());
+    // KITTI depth PNGs hold metres * 256 in uint16: values are rounded to 1/256 m and clamped to
+    // 65535 / 256 m, and 0 means none.
+    const float png_max = 65535.f / 256.f;
+    int both = 0, only_ros = 0, only_runner = 0, off = 0, disparity_off = 0;
+    double max_diff = 0;
+    for (int y = 0; y < z_ros.rows; ++y) {
+      for (int x = 0; x < z_ros.cols; ++x) {
+        const float z = z_ros(y, x), zr = z_runner(y, x);
+        const bool has_ros = std::isfinite(z) && z > 0, has_runner = zr > 0;
+        if (has_ros && !(std::abs(z - fx * baseline / d_ros(y, x)) <= 1e-3 * z)) ++disparity_off;
+        if (has_ros && has_runner) {
+          ++both;
+          const double diff = std::abs(std::min(z, png_max) - zr);
+          max_diff = std::max(max_diff, diff);
+          if (diff > 0.5 / 256 + 1e-4) ++off;
+        } else if (has_ros) {
+          ++only_ros;
+        } else if (has_runner) {
+          ++only_runner;
+        }
+      }
+    }
+    const int pixels = z_ros.rows * z_ros.cols;
+    std::printf("frame %s: depth in both %d (%.1f %%), only nodelet %d, only runner %d, "
+                "off by more than the PNG rounding %d, max |diff| %.4f m\n",
+                kReplayFrames[i].c_str(), both, 100.0 * both / pixels, only_ros, only_runner, off,
+                max_diff);
+    EXPECT_EQ(disparity_off, 0);
+    EXPECT_GT(both, pixels / 2);
+    EXPECT_EQ(only_ros + only_runner, 0);
+    EXPECT_EQ(off, 0);
+  }
+  bag.close();
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_kitti_bag");
+  ros::NodeHandle nh;
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,527 @@
+// Unit tests of the ROS layer without a ROS master: message conversions, sweep matching and the
+// parameter mapping (cfg/Fusion.cfg and config/fusion.yaml against the core structs).
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <set>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include <dynamic_reconfigure/Config.h>
+#include <opencv2/core.hpp>
+#include <sensor_msgs/image_encodings.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include "lidar_stereo_fusion/io/params_yaml.h"
+#include "lidar_stereo_fusion/ros/conversions.h"
+#include "lidar_stereo_fusion/ros/frame_matcher.h"
+#include "lidar_stereo_fusion/ros/ros_params.h"
+
+namespace lsf = lidar_stereo_fusion;
+namespace conv = lidar_stereo_fusion::conversions;
+using sensor_msgs::PointField;
+
+namespace {
+
+sensor_msgs::ImagePtr makeImage(int width, int height, const std::string& encoding,
+                                const std::vector<uint8_t>& pixel) {
+  auto msg = boost::make_shared<sensor_msgs::Image>();
+  msg->width = width;
+  msg->height = height;
+  msg->encoding = encoding;
+  msg->step = width * static_cast<uint32_t>(pixel.size());
+  for (int i = 0; i < width * height; ++i) msg->data.insert(msg->data.end(), pixel.begin(), pixel.end());
+  return msg;
+}
+
+sensor_msgs::CameraInfo info(double fx, double tx, int width = 64, int height = 32) {
+  sensor_msgs::CameraInfo c;
+  c.width = width;
+  c.height = height;
+  c.P = {fx, 0, 31.5, tx, 0, fx, 15.5, 0, 0, 0, 1, 0};
+  return c;
+}
+
+/// A cloud with one point per entry of `xyz`, fields laid out as given.
+struct FieldSpec {
+  std::string name;
+  uint8_t datatype;
+};
+int sizeOf(uint8_t datatype) {
+  switch (datatype) {
+    case PointField::INT8:
+    case PointField::UINT8:
+      return 1;
+    case PointField::INT16:
+    case PointField::UINT16:
+      return 2;
+    case PointField::FLOAT64:
+      return 8;
+    default:
+      return 4;
+  }
+}
+template <class T>
+void put(uint8_t* p, double v) {
+  const T t = static_cast<T>(v);
+  std::memcpy(p, &t, sizeof(T));
+}
+void putValue(uint8_t* p, uint8_t datatype, double v) {
+  switch (datatype) {
+    case PointField::INT8: put<int8_t>(p, v); break;
+    case PointField::UINT8: put<uint8_t>(p, v); break;
+    case PointField::INT16: put<int16_t>(p, v); break;
+    case PointField::UINT16: put<uint16_t>(p, v); break;
+    case PointField::INT32: put<int32_t>(p, v); break;
+    case PointField::UINT32: put<uint32_t>(p, v); break;
+    case PointField::FLOAT32: put<float>(p, v); break;
+    default: put<double>(p, v); break;
+  }
+}
+sensor_msgs::PointCloud2 makeCloud(const std::vector<FieldSpec>& fields,
+                                   const std::vector<std::vector<double>>& points,
+                                   int padding = 3) {
+  sensor_msgs::PointCloud2 msg;
+  uint32_t offset = 0;
+  for (const auto& f : fields) {
+    PointField pf;
+    pf.name = f.name;
+    pf.datatype = f.datatype;
+    pf.count = 1;
+    pf.offset = offset;
+    offset += sizeOf(f.datatype) + padding;  // odd padding: unaligned fields
+    msg.fields.push_back(pf);
+  }
+  msg.point_step = offset;
+  msg.height = 1;
+  msg.width = points.size();
+  msg.row_step = msg.point_step * msg.width;
+  msg.data.assign(msg.row_step, 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (std::size_t f = 0; f < fields.size(); ++f) {
+      putValue(&msg.data[i * msg.point_step + msg.fields[f].offset], fields[f].datatype,
+               points[i][f]);
+    }
+  }
+  return msg;
+}
+
+}  // namespace
+
+// --- images --------------------------------------------------------------------------------------
+TEST(Conversions, EveryEncodingGivesBgrOrGrey) {
+  // One pixel colour: blue 10, green 20, red 30.
+  const std::map<std::string, std::vector<uint8_t>> pixels = {
+      {"bgr8", {10, 20, 30}}, {"rgb8", {30, 20, 10}}, {"bgra8", {10, 20, 30, 255}},
+      {"rgba8", {30, 20, 10, 255}}};
+  for (const auto& kv : pixels) {
+    const cv::Mat out = conv::imageToCore(makeImage(4, 3, kv.first, kv.second));
+    ASSERT_EQ(out.type(), CV_8UC3) << kv.first;
+    EXPECT_EQ(out.at<cv::Vec3b>(2, 3), cv::Vec3b(10, 20, 30)) << kv.first;
+  }
+  const cv::Mat grey = conv::imageToCore(makeImage(4, 3, "mono8", {77}));
+  ASSERT_EQ(grey.type(), CV_8UC1);
+  EXPECT_EQ(grey.at<uint8_t>(1, 1), 77);
+}
+
+TEST(Conversions, MixedMonoAndColourPairBecomesBgr) {
+  cv::Mat left, right;
+  conv::stereoPairToCore(makeImage(4, 3, "mono8", {50}), makeImage(4, 3, "bgr8", {1, 2, 3}), left,
+                         right);
+  EXPECT_EQ(left.type(), CV_8UC3);
+  EXPECT_EQ(right.type(), CV_8UC3);
+  EXPECT_EQ(left.at<cv::Vec3b>(0, 0), cv::Vec3b(50, 50, 50));
+}
+
+TEST(Conversions, BadImagesAreRejectedWithTheReason) {
+  try {
+    conv::imageToCore(makeImage(4, 3, "16UC1", {0, 0}));
+    FAIL() << "16UC1 accepted";
+  } catch (const conv::ConversionError& e) {
+    EXPECT_NE(std::string(e.what()).find("16UC1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bgra8"), std::string::npos) << "lists the supported";
+  }
+  auto truncated = makeImage(4, 3, "bgr8", {1, 2, 3});
+  truncated->data.resize(10);
+  EXPECT_FALSE(conv::checkImage(*truncated).empty());
+  EXPECT_THROW(conv::imageToCore(truncated), conv::ConversionError);
+  cv::Mat l, r;
+  EXPECT_THROW(conv::stereoPairToCore(makeImage(4, 3, "bgr8", {1, 2, 3}),
+                                      makeImage(5, 3, "bgr8", {1, 2, 3}), l, r),
+               conv::ConversionError);
+}
+
+// --- camera --------------------------------------------------------------------------------------
+TEST(Conversions, BaselineFromEitherSignOfTx) {
+  const double fx = 700.0, B = 0.12;
+  for (const double sign : {-1.0, 1.0}) {
+    const lsf::StereoCamera c = conv::stereoCameraFromInfo(info(fx, 0.0), info(fx, sign * fx * B));
+    EXPECT_DOUBLE_EQ(c.fx, fx);
+    EXPECT_DOUBLE_EQ(c.fy, fx);
+    EXPECT_DOUBLE_EQ(c.cx, 31.5);
+    EXPECT_DOUBLE_EQ(c.cy, 15.5);
+    EXPECT_NEAR(c.baseline, B, 1e-12);
+    EXPECT_EQ(c.width, 64);
+    EXPECT_EQ(c.height, 32);
+  }
+}
+
+TEST(Conversions, UnusableCameraInfoNamesTheCamera) {
+  try {
+    conv::stereoCameraFromInfo(info(0.0, 0.0), info(700.0, -84.0));
+    FAIL();
+  } catch (const conv::ConversionError& e) {
+    EXPECT_NE(std::string(e.what()).find("left camera_info"), std::string::npos) << e.what();
+  }
+  try {
+    conv::stereoCameraFromInfo(info(700.0, 0.0), info(700.0, 0.0));  // right = left
+    FAIL();
+  } catch (const conv::ConversionError& e) {
+    EXPECT_NE(std::string(e.what()).find("right camera_info"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(conv::stereoCameraFromInfo(info(700.0, 0.0), info(650.0, -84.0)),
+               conv::ConversionError);
+  EXPECT_THROW(conv::stereoCameraFromInfo(info(700.0, 0.0), info(700.0, -84.0, 32, 32)),
+               conv::ConversionError);
+}
+
+// --- clouds --------------------------------------------------------------------------------------
+TEST(Conversions, VelodyneLayoutWithAnyNumericTypes) {
+  const std::vector<uint8_t> ring_types = {PointField::UINT8, PointField::UINT16, PointField::INT32,
+                                           PointField::FLOAT32, PointField::FLOAT64};
+  const std::vector<uint8_t> time_types = {PointField::FLOAT32, PointField::FLOAT64,
+                                           PointField::UINT32};
+  for (const uint8_t xyz : {PointField::FLOAT32, PointField::FLOAT64}) {
+    for (const uint8_t ring : ring_types) {
+      for (const uint8_t time : time_types) {
+        const auto msg = makeCloud({{"x", xyz}, {"y", xyz}, {"z", xyz}, {"intensity", PointField::UINT8},
+                                    {"ring", ring}, {"time", time}},
+                                   {{1.5, -2.25, 0.5, 200, 7, 3}, {10.0, 0.0, -1.0, 3, 0, 0}});
+        const conv::CloudConversion out = conv::cloudFromMsg(msg);
+        ASSERT_EQ(out.cloud.size(), 2u);
+        EXPECT_TRUE(out.has_ring);
+        EXPECT_TRUE(out.has_time);
+        EXPECT_FLOAT_EQ(out.cloud[0].x, 1.5f);
+        EXPECT_FLOAT_EQ(out.cloud[0].y, -2.25f);
+        EXPECT_FLOAT_EQ(out.cloud[0].z, 0.5f);
+        EXPECT_FLOAT_EQ(out.cloud[0].intensity, 200.f);
+        EXPECT_EQ(out.cloud[0].ring, 7);
+        EXPECT_FLOAT_EQ(out.cloud[0].time, 3.f);
+        EXPECT_EQ(out.cloud[1].ring, 0);
+      }
+    }
+  }
+}
+
+TEST(Conversions, CloudWithoutRingAndWithNaN) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto msg = makeCloud({{"x", PointField::FLOAT32}, {"y", PointField::FLOAT32},
+                              {"z", PointField::FLOAT32}, {"laser_id", PointField::UINT16}},
+                             {{1, 2, 3, 5}, {nan, 0, 0, 1}, {0, std::numeric_limits<double>::infinity(), 0, 1}});
+  const conv::CloudConversion out = conv::cloudFromMsg(msg);
+  EXPECT_FALSE(out.has_ring);
+  EXPECT_FALSE(out.has_time);
+  EXPECT_EQ(out.total_points, 3);
+  EXPECT_EQ(out.non_finite, 2);
+  ASSERT_EQ(out.cloud.size(), 1u);
+  EXPECT_EQ(out.cloud[0].ring, -1);
+}
+
+TEST(Conversions, OrganisedCloudWithRowPadding) {
+  auto msg = makeCloud({{"x", PointField::FLOAT32}, {"y", PointField::FLOAT32}, {"z", PointField::FLOAT32}},
+                       {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}, {10, 11, 12}}, 0);
+  // Re-lay the 4 points as 2 rows of 2 with 8 bytes of padding at the end of each row.
+  sensor_msgs::PointCloud2 organised = msg;
+  organised.height = 2;
+  organised.width = 2;
+  organised.row_step = 2 * msg.point_step + 8;
+  organised.data.assign(organised.row_step * 2, 0xff);
+  for (int r = 0; r < 2; ++r) {
+    std::memcpy(&organised.data[r * organised.row_step], &msg.data[r * 2 * msg.point_step],
+                2 * msg.point_step);
+  }
+  const conv::CloudConversion out = conv::cloudFromMsg(organised);
+  ASSERT_EQ(out.cloud.size(), 4u);
+  EXPECT_FLOAT_EQ(out.cloud[3].z, 12.f);
+}
+
+TEST(Conversions, MalformedCloudsAreRejectedWithTheReason) {
+  auto no_z = makeCloud({{"x", PointField::FLOAT32}, {"y", PointField::FLOAT32}}, {{1, 2}});
+  EXPECT_NE(conv::checkCloudLayout(no_z).find("'z'"), std::string::npos);
+  EXPECT_THROW(conv::cloudFromMsg(no_z), conv::ConversionError);
+
+  auto ok = makeCloud({{"x", PointField::FLOAT32}, {"y", PointField::FLOAT32}, {"z", PointField::FLOAT32}},
+                      {{1, 2, 3}, {4, 5, 6}});
+  auto short_data = ok;
+  short_data.data.resize(short_data.data.size() - 1);
+  EXPECT_FALSE(conv::checkCloudLayout(short_data).empty());
+  auto small_step = ok;
+  small_step.point_step = 6;
+  small_step.row_step = 12;
+  EXPECT_FALSE(conv::checkCloudLayout(small_step).empty());
+  auto big_endian = ok;
+  big_endian.is_bigendian = true;
+  EXPECT_FALSE(conv::checkCloudLayout(big_endian).empty());
+  auto empty = ok;
+  empty.width = 0;
+  empty.row_step = 0;
+  empty.data.clear();
+  EXPECT_TRUE(conv::checkCloudLayout(empty).empty()) << "empty is well-formed (rejected later)";
+  EXPECT_TRUE(conv::cloudFromMsg(empty).cloud.empty());
+}
+
+TEST(Conversions, CloudRoundTrip) {
+  lsf::LidarCloud cloud(3);
+  for (int i = 0; i < 3; ++i) {
+    cloud[i].x = i;
+    cloud[i].y = -i;
+    cloud[i].z = 0.5f * i;
+    cloud[i].intensity = 10.f * i;
+    cloud[i].ring = i + 1;
+    cloud[i].time = 0.01f * i;
+  }
+  std_msgs::Header header;
+  header.frame_id = "velodyne";
+  const conv::CloudConversion out = conv::cloudFromMsg(conv::cloudToMsg(cloud, header));
+  ASSERT_EQ(out.cloud.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_FLOAT_EQ(out.cloud[i].y, -i);
+    EXPECT_EQ(out.cloud[i].ring, i + 1);
+    EXPECT_FLOAT_EQ(out.cloud[i].time, 0.01f * i);
+  }
+}
+
+// --- outputs -------------------------------------------------------------------------------------
+TEST(Conversions, DepthHasNanWhereEmptyOrTooFar) {
+  cv::Mat1f depth(2, 3, 0.f);
+  depth(0, 1) = 5.f;
+  depth(1, 2) = 50.f;
+  std_msgs::Header header;
+  header.frame_id = "cam";
+  const auto msg = conv::depthToMsg(depth, header, 40.0);
+  EXPECT_EQ(msg->encoding, "32FC1");
+  EXPECT_EQ(msg->step, 12u);
+  const float* d = reinterpret_cast<const float*>(msg->data.data());
+  EXPECT_TRUE(std::isnan(d[0]));
+  EXPECT_FLOAT_EQ(d[1], 5.f);
+  EXPECT_TRUE(std::isnan(d[5])) << "beyond max_depth";
+}
+
+TEST(Conversions, DisparityImageLikeStereoImageProc) {
+  cv::Mat1f disparity(10, 20, 0.f);
+  disparity(3, 4) = 0.6f;   // below the search range: widens min_disparity
+  disparity(7, 15) = 250.f; // above: widens max_disparity
+  lsf::StereoCamera camera;
+  camera.fx = 500;
+  camera.baseline = 0.3;
+  std_msgs::Header header;
+  const auto msg = conv::disparityToMsg(disparity, header, camera, 1.0, 192.0);
+  EXPECT_FLOAT_EQ(msg->f, 500.f);
+  EXPECT_FLOAT_EQ(msg->T, 0.3f);
+  EXPECT_FLOAT_EQ(msg->min_disparity, 0.6f);
+  EXPECT_FLOAT_EQ(msg->max_disparity, 250.f);
+  EXPECT_GT(msg->min_disparity, 0.f) << "0 (no value) must be below min_disparity";
+  EXPECT_EQ(msg->valid_window.x_offset, 4u);
+  EXPECT_EQ(msg->valid_window.y_offset, 3u);
+  EXPECT_EQ(msg->valid_window.width, 12u);
+  EXPECT_EQ(msg->valid_window.height, 5u);
+  EXPECT_EQ(msg->image.encoding, "32FC1");
+}
+
+TEST(Conversions, ColouredCloudPacksRgbLikePcl) {
+  std::vector<lsf::ColoredPoint> points(1);
+  points[0] = {1.f, 2.f, 3.f, 200, 100, 50};
+  std_msgs::Header header;
+  const auto msg = conv::coloredCloudToMsg(points, header);
+  sensor_msgs::PointCloud2ConstIterator<uint8_t> r(*msg, "r"), g(*msg, "g"), b(*msg, "b");
+  EXPECT_EQ(*r, 200);
+  EXPECT_EQ(*g, 100);
+  EXPECT_EQ(*b, 50);
+  sensor_msgs::PointCloud2ConstIterator<float> z(*msg, "z");
+  EXPECT_FLOAT_EQ(*z, 3.f);
+}
+
+// --- sweep matching ------------------------------------------------------------------------------
+using Matcher = lsf::FrameMatcher<int, int>;
+using Clock = Matcher::Clock;
+
+TEST(FrameMatcher, SweepStampedAfterTheImageArrivingLater) {
+  Matcher m;
+  const auto now = Clock::now();
+  auto ev = m.addSweep(ros::Time(9.95), 1, now);  // previous sweep
+  ev = m.addImages(ros::Time(10.0), 100, now);
+  EXPECT_TRUE(ev.ready.empty()) << "must wait: a later sweep may be nearer";
+  ev = m.addSweep(ros::Time(10.08), 2, now);
+  ASSERT_EQ(ev.ready.size(), 1u);
+  EXPECT_EQ(ev.ready[0].images, 100);
+  EXPECT_EQ(ev.ready[0].sweep, 1) << "9.95 is nearer than 10.08";
+}
+
+TEST(FrameMatcher, NearestOfBothSidesWithinTheOffset) {
+  Matcher m;
+  const auto now = Clock::now();
+  m.addSweep(ros::Time(9.85), 1, now);
+  m.addImages(ros::Time(10.0), 100, now);
+  auto ev = m.addSweep(ros::Time(10.07), 2, now);
+  ASSERT_EQ(ev.ready.size(), 1u);
+  EXPECT_EQ(ev.ready[0].sweep, 2);
+  EXPECT_EQ(ev.ready[0].sweep_stamp, ros::Time(10.07));
+}
+
+TEST(FrameMatcher, SweepAlreadyThere) {
+  Matcher m;
+  const auto now = Clock::now();
+  m.addSweep(ros::Time(10.0), 1, now);
+  auto ev = m.addImages(ros::Time(10.0), 100, now);
+  ASSERT_EQ(ev.ready.size(), 1u);
+  EXPECT_EQ(ev.ready[0].sweep, 1);
+}
+
+TEST(FrameMatcher, EarlierSweepIsTakenAfterWaiting) {
+  Matcher::Params p;
+  p.max_wait = 0.2;
+  Matcher m(p);
+  const auto now = Clock::now();
+  m.addSweep(ros::Time(9.95), 1, now);
+  EXPECT_TRUE(m.addImages(ros::Time(10.0), 100, now).ready.empty());
+  EXPECT_TRUE(m.poll(now + std::chrono::milliseconds(100)).ready.empty());
+  auto ev = m.poll(now + std::chrono::milliseconds(250));
+  ASSERT_EQ(ev.ready.size(), 1u);
+  EXPECT_EQ(ev.ready[0].sweep, 1);
+}
+
+TEST(FrameMatcher, NoSweepWithinTheOffsetIsUnmatched) {
+  Matcher m;  // max_time_offset 0.1
+  const auto now = Clock::now();
+  m.addSweep(ros::Time(9.8), 1, now);
+  m.addImages(ros::Time(10.0), 100, now);
+  auto ev = m.addSweep(ros::Time(10.15), 2, now);
+  EXPECT_TRUE(ev.ready.empty());
+  ASSERT_EQ(ev.unmatched.size(), 1u);
+  EXPECT_EQ(ev.unmatched[0], ros::Time(10.0));
+  EXPECT_EQ(m.pendingCount(), 0u);
+}
+
+TEST(FrameMatcher, OutOfOrderAndDuplicateStampsAreRejected) {
+  Matcher m;
+  const auto now = Clock::now();
+  EXPECT_FALSE(m.addSweep(ros::Time(10.0), 1, now).out_of_order);
+  EXPECT_TRUE(m.addSweep(ros::Time(9.9), 2, now).out_of_order);
+  EXPECT_TRUE(m.addSweep(ros::Time(10.0), 3, now).out_of_order);
+  EXPECT_FALSE(m.addImages(ros::Time(10.0), 100, now).out_of_order);
+  EXPECT_TRUE(m.addImages(ros::Time(9.9), 101, now).out_of_order);
+  EXPECT_TRUE(m.addImages(ros::Time(10.0), 102, now).out_of_order);
+  m.clear();
+  EXPECT_FALSE(m.addImages(ros::Time(5.0), 103, now).out_of_order) << "clear() forgets stamps";
+}
+
+TEST(FrameMatcher, TooManyPendingDecidesTheOldest) {
+  Matcher::Params p;
+  p.max_pending = 2;
+  Matcher m(p);
+  const auto now = Clock::now();
+  m.addSweep(ros::Time(9.99), 1, now);
+  m.addImages(ros::Time(10.0), 100, now);
+  m.addImages(ros::Time(10.1), 101, now);
+  auto ev = m.addImages(ros::Time(10.2), 102, now);
+  ASSERT_EQ(ev.ready.size(), 1u);
+  EXPECT_EQ(ev.ready[0].images, 100);
+  EXPECT_EQ(m.pendingCount(), 2u);
+}
+
+TEST(FrameMatcher, SeveralReadyAtOnceOldestFirst) {
+  Matcher m;
+  const auto now = Clock::now();
+  m.addImages(ros::Time(10.0), 100, now);
+  m.addImages(ros::Time(10.05), 101, now);
+  auto ev = m.addSweep(ros::Time(10.06), 1, now);
+  ASSERT_EQ(ev.ready.size(), 2u);
+  EXPECT_EQ(ev.ready[0].images, 100);
+  EXPECT_EQ(ev.ready[1].images, 101);
+}
+
+// --- parameters ----------------------------------------------------------------------------------
+namespace {
+std::map<std::string, std::string> configEntries(const lsf::FusionConfig& config) {
+  dynamic_reconfigure::Config msg;
+  config.__toMessage__(msg);
+  std::map<std::string, std::string> out;
+  for (const auto& p : msg.doubles) out[p.name] = "double " + std::to_string(p.value);
+  for (const auto& p : msg.ints) out[p.name] = "int " + std::to_string(p.value);
+  for (const auto& p : msg.bools) out[p.name] = std::string("bool ") + (p.value ? "true" : "false");
+  for (const auto& p : msg.strs) out[p.name] = "string " + p.value;
+  return out;
+}
+}  // namespace
+
+TEST(RosParams, ReconfigureHasExactlyTheCoreParameters) {
+  const auto entries = configEntries(lsf::FusionConfig::__getDefault__());
+  std::set<std::string> listed;
+  for (const auto& info : lsf::ros_params::listParams()) {
+    listed.insert(info.reconfigure_name);
+    ASSERT_TRUE(entries.count(info.reconfigure_name))
+        << info.reconfigure_name << " is missing from cfg/Fusion.cfg";
+    EXPECT_EQ(entries.at(info.reconfigure_name).substr(0, info.type.size()), info.type)
+        << info.reconfigure_name;
+  }
+  for (const auto& kv : entries) {
+    EXPECT_TRUE(listed.count(kv.first)) << kv.first << " in cfg/Fusion.cfg is not a core parameter";
+  }
+}
+
+TEST(RosParams, ReconfigureDefaultsAreTheStructDefaults) {
+  const auto cfg = configEntries(lsf::FusionConfig::__getDefault__());
+  const auto structs = configEntries(lsf::ros_params::toConfig(lsf::FusionParams()));
+  for (const auto& kv : structs) {
+    EXPECT_EQ(cfg.at(kv.first), kv.second) << kv.first << ": cfg default vs FusionParams default";
+  }
+}
+
+TEST(RosParams, ConfigRoundTripKeepsEveryField) {
+  lsf::FusionParams p;
+  p.method = lsf::Method::kFusedBF;
+  p.projection.max_depth = 77.0;
+  p.bi.search_lines = 1;
+  p.bf.sigma_range = 3.5;
+  p.patchmatch.window_radius = 9;
+  p.patchmatch.slanted = false;
+  p.patchmatch.seed = 1234;
+  const lsf::FusionParams q = lsf::ros_params::fromConfig(lsf::ros_params::toConfig(p));
+  EXPECT_EQ(lsf::ros_params::describeChanges(p, q), "");
+  EXPECT_EQ(q.method, lsf::Method::kFusedBF);
+  EXPECT_EQ(q.patchmatch.seed, 1234u);
+  EXPECT_NE(lsf::ros_params::describeChanges(lsf::FusionParams(), p).find("patchmatch/window_radius: 5 -> 9"),
+            std::string::npos)
+      << lsf::ros_params::describeChanges(lsf::FusionParams(), p);
+}
+
+TEST(RosParams, UnknownMethodInReconfigureIsNamed) {
+  lsf::FusionConfig config = lsf::FusionConfig::__getDefault__();
+  config.method = "sgbm";
+  try {
+    lsf::ros_params::fromConfig(config);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("method"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RosParams, ShippedYamlHasEveryParameterAndLoadsInTheCore) {
+  const std::string path = std::string(LSF_SOURCE_DIR) + "/config/fusion.yaml";
+  lsf::FusionParams loaded;
+  ASSERT_NO_THROW(lsf::loadParamsYaml(path, loaded));
+  EXPECT_EQ(lsf::ros_params::describeChanges(lsf::FusionParams(), loaded), "")
+      << "config/fusion.yaml documents the paper's values, which are the struct defaults";
+  cv::FileStorage fs(path, cv::FileStorage::READ);
+  ASSERT_TRUE(fs.isOpened());
+  for (const auto& info : lsf::ros_params::listParams()) {
+    const auto slash = info.ros_name.find('/');
+    const cv::FileNode node = slash == std::string::npos
+                                  ? fs[info.ros_name]
+                                  : fs[info.ros_name.substr(0, slash)][info.ros_name.substr(slash + 1)];
+    EXPECT_FALSE(node.empty()) << info.ros_name << " is missing from config/fusion.yaml";
+  }
+}
