@@ -589,23 +589,37 @@ cv::Mat1f disparityOf(const ViewState& v) {
   return d;
 }
 
-/// Left-right check: marks left pixels whose match disagrees by more than max_diff.
+/// Left-right check: marks left pixels whose match disagrees by more than max_diff. A pixel whose
+/// match falls outside the right image (the left border strip) cannot be checked and is kept.
 cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float max_diff) {
   cv::Mat1b bad(left.size(), uchar(0));
   for (int y = 0; y < left.rows; ++y) {
     for (int x = 0; x < left.cols; ++x) {
       const float d = left(y, x);
       const int xr = static_cast<int>(std::lround(x - d));
-      if (xr < 0 || xr >= right.cols || std::abs(right(y, xr) - d) > max_diff) bad(y, x) = 255;
+      if (xr < 0 || xr >= right.cols) continue;
+      if (std::abs(right(y, xr) - d) > max_diff) bad(y, x) = 255;
     }
   }
   return bad;
 }
 
-/// Fills inconsistent pixels with the lower disparity of the nearest consistent planes to the left
-/// and right (Bleyer et al.), then smooths filled pixels with a colour-weighted median.
-void fillHoles(const ViewState& v, const cv::Mat1b& bad, int radius, float delta,
-               cv::Mat1f& disparity, int threads) {
+/// Fills inconsistent pixels. Where the up-sampled LiDAR prior has a value, the prior fills the
+/// hole (the LiDAR saw the point; this is our reading for the fused method: Bleyer's background
+/// fill assumes no other source). Elsewhere, the lower disparity of the nearest consistent planes
+/// to the left and right (Bleyer et al.), smoothed by a colour-weighted median.
+void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, cv::Mat1f& disparity,
+               int threads) {
+  if (!v.prior.empty()) {
+    for (int y = 0; y < v.height; ++y) {
+      for (int x = 0; x < v.width; ++x) {
+        if (bad(y, x) && v.prior(y, x) > 0.f) {
+          disparity(y, x) = v.prior(y, x);
+          bad(y, x) = 0;
+        }
+      }
+    }
+  }
   cv::Mat1f filled = disparity.clone();
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
@@ -699,7 +713,7 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   if (p.lr_check) {
     result.inconsistent =
         leftRightCheck(result.disparity, result.right_disparity, static_cast<float>(p.lr_max_diff));
-    fillHoles(lv, result.inconsistent, std::max(p.window_radius, 5),
+    fillHoles(lv, result.inconsistent.clone(), std::max(p.window_radius, 5),
               static_cast<float>(p.weight_delta), result.disparity, threadCount(p));
   } else {
     result.inconsistent = cv::Mat1b(size, uchar(0));
