@@ -648,10 +648,11 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, cv::M
       samples.clear();
       const cv::Vec3f& c = v.color(y, x);
       float total = 0.f;
-      for (int yy = std::max(0, y - radius); yy <= std::min(v.height - 1, y + radius); ++yy) {
+      // Every second row and column of the window: the median barely changes, the cost quarters.
+      for (int yy = std::max(0, y - radius); yy <= std::min(v.height - 1, y + radius); yy += 2) {
         const float* frow = filled.ptr<float>(yy);
         const cv::Vec3f* crow = v.color.ptr<cv::Vec3f>(yy);
-        for (int xx = std::max(0, x - radius); xx <= std::min(v.width - 1, x + radius); ++xx) {
+        for (int xx = std::max(0, x - radius); xx <= std::min(v.width - 1, x + radius); xx += 2) {
           const float d = frow[xx];
           if (d <= 0.f) continue;
           const cv::Vec3f& q = crow[xx];
