@@ -125,6 +125,15 @@ struct WindowCache {
   }
 };
 
+constexpr float kSamePlaneTolerance = 0.01f;  // [px]
+
+/// True when two planes agree to kSamePlaneTolerance px at (x, y) and to 1e-3 in slope:
+/// evaluating one after the other cannot change the result meaningfully.
+bool nearlySame(const Plane& p, const Plane& q, float x, float y) {
+  return std::abs(p.at(x, y) - q.at(x, y)) < kSamePlaneTolerance && std::abs(p.a - q.a) < 1e-3f &&
+         std::abs(p.b - q.b) < 1e-3f;
+}
+
 class Solver {
  public:
   Solver(const PatchMatchParams& params, ViewState& self, const ViewState& other)
@@ -216,10 +225,13 @@ class Solver {
     const float* pr = cache.priors.data();
     const float* pv = cache.prior_valid.data();
     const int* ro = cache.row_offset.data();
-    for (int start = 0; start < cache.count; start += kChunk) {
-      const int end = std::min(cache.count, start + kChunk);
+    // Early-exit checks once per window row's worth of samples: most refinement candidates are
+    // worse than the current plane, and the partial sum often exceeds it after a row or two.
+    const int chunk = static_cast<int>(offsets_.size());
+    for (int start = 0; start < cache.count; start += chunk) {
+      const int end = std::min(cache.count, start + chunk);
       float part = 0.f;
-#pragma omp simd reduction(+ : part)
+// (no `omp simd`: windows hold 9-25 samples, too few for 16-lane reductions to pay off)
       for (int k = start; k < end; ++k) {
         const float d = a * xs[k] + b * ys[k] + c;
         const float xm_raw = xs[k] + sign * d;
@@ -335,8 +347,9 @@ class Solver {
 
   void tryPlane(int x, int y, const Plane& candidate, const WindowCache& cache, Plane& best,
                 float& best_cost) const {
-    // Propagation often offers the plane the pixel already has: nothing to evaluate.
-    if (candidate.a == best.a && candidate.b == best.b && candidate.c == best.c) return;
+    // Propagation often offers (nearly) the plane the pixel already has: evaluating it cannot
+    // change the result by more than the tolerance, so skip it.
+    if (nearlySame(candidate, best, static_cast<float>(x), static_cast<float>(y))) return;
     if (!admissible(x, y, candidate.at(static_cast<float>(x), static_cast<float>(y)))) return;
     const float c = cost(cache, candidate, best_cost);
     if (c < best_cost) {
@@ -381,7 +394,6 @@ class Solver {
   const std::vector<int>& offsets() const { return offsets_; }
 
  private:
-  static constexpr int kChunk = 16;            // samples between early-exit checks
   static constexpr int kLutSize = 4096;
   static constexpr float kLutScale = 4.f;        // LUT entries per unit of RGB L1 distance
   static constexpr float kMinNormalZ = 0.1f;     // rejects planes steeper than ~84 degrees
@@ -541,13 +553,6 @@ void sweep(const Solver& solver, ViewState& v, const PatchMatchParams& p, int it
       }
     }
   }
-}
-
-/// True when two planes agree to 1e-3 px at (x, y) and in slope: evaluating one after the other
-/// cannot change the result meaningfully.
-bool nearlySame(const Plane& p, const Plane& q, float x, float y) {
-  return std::abs(p.at(x, y) - q.at(x, y)) < 1e-3f && std::abs(p.a - q.a) < 1e-4f &&
-         std::abs(p.b - q.b) < 1e-4f;
 }
 
 /// View propagation: every pixel of `src` offers its plane to the pixel it matches in `dst`.
