@@ -16,7 +16,7 @@ set(LSF_ROS_TEST_DEFINITIONS
 
 catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp)
 if(TARGET test_ros_unit)
-  target_link_libraries(test_ros_unit ${PROJECT_NAME}_ros)
+  target_link_libraries(test_ros_unit ${PROJECT_NAME}_ros ${GTEST_MAIN_LIBRARIES})
   target_compile_definitions(test_ros_unit PRIVATE ${LSF_ROS_TEST_DEFINITIONS})
 endif()
 

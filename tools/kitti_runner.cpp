@@ -55,10 +55,10 @@ struct Options {
 };
 
 Options parseOptions(int argc, char** argv) {
-  const lsf::CommandLine cl(argc, argv,
-                            {"--kitti-raw", "--out", "--method", "--params", "--reference",
-                             "--frames", "--holdout"},
-                            {"--save-vis", "--help"});
+  const lsf::CommandLine cl(
+      argc, argv,
+      {"--kitti-raw", "--out", "--method", "--params", "--reference", "--frames", "--holdout"},
+      {"--save-vis", "--help"});
   Options o;
   if (cl.has("--help")) return o;
   o.drive = cl.value("--kitti-raw");
@@ -109,9 +109,9 @@ std::optional<cv::Mat1f> referenceOf(const Options& o, const lsf::kitti::Frame& 
   cv::Mat1f reference = lsf::kitti::readDepthPng(path.string());
   if (reference.cols != camera.width || reference.rows != camera.height) {
     throw std::runtime_error("reference " + path.string() + " is " +
-                             std::to_string(reference.cols) + "x" +
-                             std::to_string(reference.rows) + ", the images are " +
-                             std::to_string(camera.width) + "x" + std::to_string(camera.height));
+                             std::to_string(reference.cols) + "x" + std::to_string(reference.rows) +
+                             ", the images are " + std::to_string(camera.width) + "x" +
+                             std::to_string(camera.height));
   }
   return reference;
 }
@@ -179,15 +179,17 @@ int run(const Options& o) {
       throw std::runtime_error("frame " + frame.name + ": " + e.what());
     }
     if (result.stats.points_in_front == 0) {
-      throw std::runtime_error("frame " + frame.name + ": no LiDAR point in front of the camera in " +
-                               frame.velodyne + " (check the sweep and calib_velo_to_cam.txt)");
+      throw std::runtime_error("frame " + frame.name +
+                               ": no LiDAR point in front of the camera in " + frame.velodyne +
+                               " (check the sweep and calib_velo_to_cam.txt)");
     }
     lsf::kitti::writeDepthPng((fs::path(o.out) / (frame.name + ".png")).string(), result.depth);
     if (reference) {
       scores.push_back(lsf::evaluateDepth(result.depth, *reference, calib.camera));
       rows.push_back({frame.name, scores.back()});
     }
-    if (o.save_vis) saveVisualisation(vis_dir, frame.name, data.left, result, reference, calib.camera);
+    if (o.save_vis)
+      saveVisualisation(vis_dir, frame.name, data.left, result, reference, calib.camera);
     stats.push_back(result.stats);
   }
   progress.update(static_cast<int>(frames.size()), "done");
@@ -197,8 +199,8 @@ int run(const Options& o) {
     throw std::runtime_error("no frame has a reference PNG in " + o.reference);
   }
   if (!scores.empty()) {
-    rows.push_back({"mean (" + std::to_string(scores.size()) + " frames)",
-                    lsf::averageMetrics(scores)});
+    rows.push_back(
+        {"mean (" + std::to_string(scores.size()) + " frames)", lsf::averageMetrics(scores)});
     std::cout << "Scores of " << lsf::methodName(params.method) << " against "
               << (o.holdout == "even" ? "the odd rings (hold-out)" : o.reference) << ":\n\n"
               << lsf::formatDepthTable(rows) << "\n";

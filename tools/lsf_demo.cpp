@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -57,8 +58,8 @@ void printUsage() {
 struct Options {
   enum class Mode { kSynthetic, kKitti, kGenerate } mode = Mode::kSynthetic;
   std::string out = "demo_output";
-  std::string kitti_dir;   ///< empty: search the default sample
-  std::string frame;       ///< KITTI frame name, empty: the first
+  std::string kitti_dir;  ///< empty: search the default sample
+  std::string frame;      ///< KITTI frame name, empty: the first
   std::string generate_dir;
   uint64_t seed = 1;
   int frames = 3;
@@ -149,8 +150,13 @@ struct DemoCase {
   lsf::FusionInput input;
   cv::Mat1f reference_depth;  ///< [m], 0 = no value (dense GT or held-out rings)
   bool dense_reference = false;
-  /// Extra regions scored separately (synthetic: the LiDAR's field of view, the dark van).
-  std::vector<std::pair<std::string, cv::Mat1b>> regions;
+  /// An extra region scored separately (synthetic: the LiDAR's field of view, the dark van).
+  struct Region {
+    std::string column;       ///< table column title
+    std::string description;  ///< what the region is
+    cv::Mat1b mask;           ///< 255 inside
+  };
+  std::vector<Region> regions;
 };
 
 struct MethodRun {
@@ -165,7 +171,7 @@ struct MethodRun {
 lsf::FusionParams demoParams(lsf::Method method, int width) {
   lsf::FusionParams params;
   params.method = method;
-  params.patchmatch.max_disparity = std::max(32.0, 192.0 * width / 1242.0);
+  params.patchmatch.max_disparity = std::max(32.0, std::round(192.0 * width / 1242.0));
   return params;
 }
 
@@ -184,7 +190,7 @@ std::vector<MethodRun> runMethods(const DemoCase& c, const std::vector<lsf::Meth
     run.all = lsf::evaluateDepth(run.result.depth, c.reference_depth, c.input.camera);
     for (const auto& region : c.regions) {
       run.regions.push_back(lsf::evaluateDepth(
-          run.result.depth, maskedDepth(c.reference_depth, region.second), c.input.camera));
+          run.result.depth, maskedDepth(c.reference_depth, region.mask), c.input.camera));
     }
     std::printf(" %.1f s\n", run.result.stats.total_ms / 1000.0);
     runs.push_back(std::move(run));
@@ -197,7 +203,7 @@ void printTable(const DemoCase& c, const std::vector<MethodRun>& runs) {
   std::printf("%-9s %8s %9s %8s %8s %7s %7s %7s %7s", "method", "MAE[mm]", "RMSE[mm]", "iMAE",
               "iRMSE", ">2px", ">3px", ">5px", "cover");
   for (const auto& region : c.regions) {
-    std::printf(" %*s", std::max(9, static_cast<int>(region.first.size())), region.first.c_str());
+    std::printf(" %*s", std::max(9, static_cast<int>(region.column.size())), region.column.c_str());
   }
   std::printf(" %8s\n", "time[s]");
   for (const MethodRun& r : runs) {
@@ -206,7 +212,7 @@ void printTable(const DemoCase& c, const std::vector<MethodRun>& runs) {
                 lsf::methodName(r.method).c_str(), m.mae_mm, m.rmse_mm, m.imae_per_km,
                 m.irmse_per_km, 100 * m.bad2, 100 * m.bad3, 100 * m.bad5, 100 * m.coverage);
     for (size_t i = 0; i < c.regions.size(); ++i) {
-      std::printf(" %*.0f", std::max(9, static_cast<int>(c.regions[i].first.size())),
+      std::printf(" %*.0f", std::max(9, static_cast<int>(c.regions[i].column.size())),
                   r.regions[i].mae_mm);
     }
     std::printf(" %8.2f\n", r.result.stats.total_ms / 1000.0);
@@ -214,14 +220,13 @@ void printTable(const DemoCase& c, const std::vector<MethodRun>& runs) {
   std::printf("Scored on %d reference pixels (%s).\n", runs.empty() ? 0 : runs.front().all.count,
               c.dense_reference ? "dense exact ground truth, sky excluded"
                                 : "held-out LiDAR rings: a consistency check, not ground truth");
-  std::printf("iMAE/iRMSE in 1/km; >Npx: disparity error > N px; pixels without an estimate count "
-              "as errors (KITTI devkit).\n");
+  std::printf(
+      "iMAE/iRMSE in 1/km; >Npx: disparity error > N px; pixels without an estimate count "
+      "as errors (KITTI devkit).\n");
   for (const auto& region : c.regions) {
-    std::printf("%s: MAE [mm] over %d pixels of %s.\n", region.first.c_str(),
-                cv::countNonZero(region.second & (c.reference_depth > 0.f)),
-                region.first == "fov MAE" ? "the LiDAR's vertical field of view (where KITTI has "
-                                            "ground truth)"
-                                          : "the dark untextured van (stereo alone fails)");
+    std::printf("%s: MAE [mm] over the %d pixels of %s.\n", region.column.c_str(),
+                cv::countNonZero(region.mask & (c.reference_depth > 0.f)),
+                region.description.c_str());
   }
 }
 
@@ -255,8 +260,9 @@ cv::Mat composite(const std::vector<std::pair<cv::Mat, std::string>>& tiles, int
   std::vector<cv::Mat> rows;
   for (size_t i = 0; i < tiles.size(); i += 2) {
     cv::Mat a = captioned(tiles[i].first, tiles[i].second, tile_width);
-    cv::Mat b = i + 1 < tiles.size() ? captioned(tiles[i + 1].first, tiles[i + 1].second, tile_width)
-                                     : cv::Mat(a.size(), a.type(), cv::Scalar(30, 30, 30));
+    cv::Mat b = i + 1 < tiles.size()
+                    ? captioned(tiles[i + 1].first, tiles[i + 1].second, tile_width)
+                    : cv::Mat(a.size(), a.type(), cv::Scalar(30, 30, 30));
     cv::Mat row;
     cv::hconcat(std::vector<cv::Mat>{a, cv::Mat(a.rows, 4, CV_8UC3, cv::Scalar(0, 0, 0)), b}, row);
     rows.push_back(row);
@@ -291,8 +297,7 @@ void writeImage(const fs::path& path, const cv::Mat& image) {
 }
 
 /// Writes the pictures; returns the composite's path.
-fs::path writePictures(const DemoCase& c, const std::vector<MethodRun>& runs,
-                       const fs::path& out) {
+fs::path writePictures(const DemoCase& c, const std::vector<MethodRun>& runs, const fs::path& out) {
   fs::create_directories(out);
   const lsf::StereoCamera& cam = c.input.camera;
   const cv::Mat1f reference = lsf::depthToDisparity(c.reference_depth, cam);
@@ -304,39 +309,41 @@ fs::path writePictures(const DemoCase& c, const std::vector<MethodRun>& runs,
                              : errorDots(c.input.left, estimate, reference, kMaxError);
   };
 
-  std::vector<std::pair<cv::Mat, std::string>> tiles;
-  auto add = [&](const std::string& file, const cv::Mat& image, const std::string& caption) {
+  std::vector<std::pair<cv::Mat, std::string>> tiles;  // the composite: rows of two
+  auto add = [&](const std::string& file, const cv::Mat& image, const std::string& caption,
+                 bool in_composite = true) {
     writeImage(out / file, image);
-    tiles.emplace_back(image, caption);
+    if (in_composite) tiles.emplace_back(image, caption);
   };
   add("left.png", c.input.left, "left image");
   add("reference.png",
       c.dense_reference ? lsf::colorizeDisparity(reference, max_d)
                         : lsf::overlaySparse(c.input.left, reference, max_d),
       c.dense_reference ? "exact ground-truth disparity" : "held-out LiDAR rings (reference)");
-  const MethodRun* first = runs.empty() ? nullptr : &runs.front();
-  if (first) {
-    add("lidar_overlay.png", lsf::overlaySparse(c.input.left, first->result.sparse.disparity, max_d),
-        "LiDAR projected into the left image");
+  if (!runs.empty()) {
+    add("lidar_overlay.png",
+        lsf::overlaySparse(c.input.left, runs.front().result.sparse.disparity, max_d),
+        c.dense_reference ? "LiDAR projected into the left image"
+                          : "LiDAR fed to the method (even rings)");
   }
-  for (lsf::Method m : {lsf::Method::kFusedBI, lsf::Method::kPlainPMS, lsf::Method::kFusedBF,
-                        lsf::Method::kLidarBF}) {
+  if (const MethodRun* r = findRun(runs, lsf::Method::kFusedBI)) {
+    add("prior_bi.png", lsf::colorizeDisparity(r->result.prior, max_d), "BI* up-sampled LiDAR");
+  }
+  for (lsf::Method m : {lsf::Method::kFusedBI, lsf::Method::kPlainPMS, lsf::Method::kFusedBF}) {
     const MethodRun* r = findRun(runs, m);
     if (!r) continue;
     const std::string name = lsf::methodName(m);
-    if (m == lsf::Method::kFusedBI) {
-      add("prior_bi.png", lsf::colorizeDisparity(r->result.prior, max_d), "BI* up-sampled LiDAR");
-    }
-    if (m == lsf::Method::kLidarBF) continue;
     add(name + "_disparity.png", lsf::colorizeDisparity(r->result.disparity, max_d),
-        name == "pms" ? "PMS (stereo only) disparity" : name + " disparity");
+        m == lsf::Method::kPlainPMS ? "PMS (stereo only) disparity" : name + " disparity",
+        m != lsf::Method::kFusedBF);
   }
   for (lsf::Method m : {lsf::Method::kFusedBI, lsf::Method::kPlainPMS}) {
     const MethodRun* r = findRun(runs, m);
     if (!r) continue;
     const std::string name = lsf::methodName(m);
     add(name + "_error.png", error(r->result.disparity),
-        name + " error (0.." + std::to_string(static_cast<int>(kMaxError)) + " px)");
+        name + " disparity error (blue 0 .. red " + std::to_string(static_cast<int>(kMaxError)) +
+            "+ px)");
   }
   const fs::path composite_path = out / "composite.png";
   writeImage(composite_path, composite(tiles, std::min(620, cam.width)));
@@ -363,10 +370,11 @@ void printOcclusionScore(const lsf::sim::SyntheticFrame& frame) {
   lsf::ScanLines after{before.disparity.clone(), before.ring.clone()};
   lsf::removeOccludedPoints(after, frame.left, params.bi);
   const lsf::sim::OcclusionRemovalScore s = lsf::sim::scoreOcclusionRemoval(frame, before, after);
-  std::printf("Algorithm 1 vs exact visibility: removed %d of %d LiDAR points the camera cannot "
-              "see (%.0f%%), kept %d of %d visible ones (%.1f%%)\n",
-              s.occluded_removed, s.occluded, 100 * s.removedFraction(), s.visible_kept, s.visible,
-              100 * s.keptFraction());
+  std::printf(
+      "Algorithm 1 vs exact visibility: removed %d of %d LiDAR points the camera cannot "
+      "see (%.0f%%), kept %d of %d visible ones (%.1f%%)\n",
+      s.occluded_removed, s.occluded, 100 * s.removedFraction(), s.visible_kept, s.visible,
+      100 * s.keptFraction());
 }
 
 DemoCase syntheticCase(const Options& o, lsf::sim::SyntheticFrame* frame_out) {
@@ -378,10 +386,11 @@ DemoCase syntheticCase(const Options& o, lsf::sim::SyntheticFrame* frame_out) {
     in_image += t.in_image ? 1 : 0;
     hidden += (t.in_image && !t.visible) ? 1 : 0;
   }
-  std::printf("Synthetic street (seed %llu, %dx%d, %d rings): generated in %.1f s; %zu LiDAR "
-              "points, %d in the left image, %d of them hidden from the left camera\n",
-              static_cast<unsigned long long>(p.seed), p.width, p.height, p.rings,
-              secondsSince(start), frame.cloud.size(), in_image, hidden);
+  std::printf(
+      "Synthetic street (seed %llu, %dx%d, %d rings): generated in %.1f s; %zu LiDAR "
+      "points, %d in the left image, %d of them hidden from the left camera\n",
+      static_cast<unsigned long long>(p.seed), p.width, p.height, p.rings, secondsSince(start),
+      frame.cloud.size(), in_image, hidden);
   DemoCase c;
   c.title = "Synthetic street, exact ground truth";
   c.input.left = frame.left;
@@ -391,7 +400,10 @@ DemoCase syntheticCase(const Options& o, lsf::sim::SyntheticFrame* frame_out) {
   c.input.camera = frame.camera;
   c.reference_depth = frame.depth;
   c.dense_reference = true;
-  c.regions = {{"fov MAE", frame.lidar_fov}, {"van MAE", frame.low_texture}};
+  c.regions = {
+      {"fov MAE", "the LiDAR's vertical field of view (where KITTI has ground truth)",
+       frame.lidar_fov},
+      {"van MAE", "the dark untextured van (stereo alone fails there)", frame.low_texture}};
   *frame_out = std::move(frame);
   return c;
 }
@@ -466,10 +478,11 @@ int generate(const Options& o) {
   e.num_frames = o.frames;
   const auto start = std::chrono::steady_clock::now();
   const std::string drive = lsf::sim::writeKittiDrive(o.generate_dir, p, e);
-  std::printf("Wrote %d synthetic frames (seed %llu, %dx%d, %d rings) in %.1f s to\n  %s\n"
-              "Exact depth: %s/proj_depth/groundtruth/image_02/*.png (KITTI format, m * 256)\n",
-              o.frames, static_cast<unsigned long long>(p.seed), p.width, p.height, p.rings,
-              secondsSince(start), fs::absolute(drive).c_str(), drive.c_str());
+  std::printf(
+      "Wrote %d synthetic frames (seed %llu, %dx%d, %d rings) in %.1f s to\n  %s\n"
+      "Exact depth: %s/proj_depth/groundtruth/image_02/*.png (KITTI format, m * 256)\n",
+      o.frames, static_cast<unsigned long long>(p.seed), p.width, p.height, p.rings,
+      secondsSince(start), fs::absolute(drive).c_str(), drive.c_str());
   return 0;
 }
 

@@ -16,8 +16,7 @@ void requireCameraSize(const cv::Mat& map, const StereoCamera& camera, const cha
   if (camera.width > 0 && (map.cols != camera.width || map.rows != camera.height)) {
     throw std::invalid_argument(std::string(who) + ": map is " + std::to_string(map.cols) + "x" +
                                 std::to_string(map.rows) + " but the camera is " +
-                                std::to_string(camera.width) + "x" +
-                                std::to_string(camera.height));
+                                std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
 }
 

@@ -15,8 +15,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// Nearest pixel of a sub-pixel coordinate: pixel i covers [i - 0.5, i + 0.5) (OpenCV centres).
-inline int roundToPixel(double u) { return static_cast<int>(std::floor(u + 0.5)); }
+/// Nearest pixel index of a sub-pixel coordinate: pixel i covers [i - 0.5, i + 0.5) (OpenCV
+/// centres). Stays a double so that far-off coordinates are compared before any int conversion.
+inline double roundToPixel(double u) { return std::floor(u + 0.5); }
 
 inline bool isFinite(const LidarPoint& p) {
   return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
@@ -90,9 +91,11 @@ SparseDisparity projectCloud(const LidarCloud& cloud, const Eigen::Isometry3d& T
     const double v = camera.fy * p.y() / z + camera.cy;
     // Right view: the same point seen at x_right = x_left - d (rectified, parallel axes); the
     // sub-pixel x_right is rounded, not round(x_left) - d.
-    const int col = roundToPixel(right ? u_left - d : u_left);
-    const int row = roundToPixel(v);
-    if (col < 0 || col >= camera.width || row < 0 || row >= camera.height) continue;
+    const double col_f = roundToPixel(right ? u_left - d : u_left);
+    const double row_f = roundToPixel(v);
+    if (!(col_f >= 0.0 && col_f < camera.width && row_f >= 0.0 && row_f < camera.height)) continue;
+    const int col = static_cast<int>(col_f);
+    const int row = static_cast<int>(row_f);
     ++out.points_in_image;
     float& stored = out.disparity(row, col);
     const float df = static_cast<float>(d);

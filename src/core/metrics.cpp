@@ -13,11 +13,10 @@ bool hasValue(float v) { return std::isfinite(v) && v > 0.f; }
 void requireSameSize(const cv::Mat& estimate, const cv::Mat& reference, const char* who) {
   if (reference.empty()) throw std::invalid_argument(std::string(who) + ": empty reference");
   if (estimate.size() != reference.size()) {
-    throw std::invalid_argument(std::string(who) + ": estimate is " +
-                                std::to_string(estimate.cols) + "x" +
-                                std::to_string(estimate.rows) + " but the reference is " +
-                                std::to_string(reference.cols) + "x" +
-                                std::to_string(reference.rows));
+    throw std::invalid_argument(
+        std::string(who) + ": estimate is " + std::to_string(estimate.cols) + "x" +
+        std::to_string(estimate.rows) + " but the reference is " + std::to_string(reference.cols) +
+        "x" + std::to_string(reference.rows));
   }
 }
 
@@ -130,8 +129,8 @@ DepthMetrics averageMetrics(const std::vector<DepthMetrics>& per_image) {
     mean.count += m.count;
   }
   if (images == 0) return DepthMetrics();
-  for (double* v : {&mean.mae_mm, &mean.rmse_mm, &mean.imae_per_km, &mean.irmse_per_km,
-                    &mean.bad2, &mean.bad3, &mean.bad5, &mean.coverage}) {
+  for (double* v : {&mean.mae_mm, &mean.rmse_mm, &mean.imae_per_km, &mean.irmse_per_km, &mean.bad2,
+                    &mean.bad3, &mean.bad5, &mean.coverage}) {
     *v /= images;
   }
   return mean;

@@ -140,9 +140,8 @@ void completeRing(const std::vector<RingPoint>& points, short ring, const BIPara
 class RangeWeightTable {
  public:
   explicit RangeWeightTable(double sigma) {
-    const double cutoff = std::sqrt(80.0) * sigma;  // exp(-40)
     scale_ = kStepsPerSigma / sigma;
-    const int size = static_cast<int>(std::ceil(cutoff * scale_)) + 2;
+    const int size = static_cast<int>(std::ceil(std::sqrt(80.0) * kStepsPerSigma)) + 2;  // e^-40
     table_.resize(size);
     for (int i = 0; i < size; ++i) {
       const double delta = i / scale_;
@@ -164,6 +163,9 @@ class RangeWeightTable {
   double scale_ = 1.0;
   double last_ = 0.0;
 };
+
+constexpr int kMaxRadius = 255;     ///< BF* half window limit [px]
+constexpr double kMinSigma = 1e-6;  ///< BF* smallest sigma [px] (keeps the tables finite)
 
 /// Sparse points of one row: column and disparity, ordered by column.
 struct RowPoint {
@@ -244,16 +246,16 @@ void BIParams::validate() const {
 }
 
 void BFParams::validate() const {
-  if (radius < 0) {
-    throw std::invalid_argument("BFParams: radius must be >= 0 [px], got " +
-                                std::to_string(radius));
+  if (radius < 0 || radius > kMaxRadius) {
+    throw std::invalid_argument("BFParams: radius must be in [0, " + std::to_string(kMaxRadius) +
+                                "] [px], got " + std::to_string(radius));
   }
-  if (!std::isfinite(sigma_space) || sigma_space <= 0.0) {
-    throw std::invalid_argument("BFParams: sigma_space must be finite and > 0 [px], got " +
+  if (!std::isfinite(sigma_space) || sigma_space < kMinSigma) {
+    throw std::invalid_argument("BFParams: sigma_space must be finite and >= 1e-6 [px], got " +
                                 std::to_string(sigma_space));
   }
-  if (!std::isfinite(sigma_range) || sigma_range <= 0.0) {
-    throw std::invalid_argument("BFParams: sigma_range must be finite and > 0 [px], got " +
+  if (!std::isfinite(sigma_range) || sigma_range < kMinSigma) {
+    throw std::invalid_argument("BFParams: sigma_range must be finite and >= 1e-6 [px], got " +
                                 std::to_string(sigma_range));
   }
   const int window = (2 * radius + 1) * (2 * radius + 1);
@@ -386,8 +388,8 @@ cv::Mat1f upsampleBF(const SparseDisparity& sparse, const BFParams& params) {
   //   ref = max_q d_q (nearest point), w_q = G_space(|p - q|) * G_range(ref - d_q),
   //   D(p) = sum w_q d_q / sum w_q,
   // evaluated as ref + sum w_q (d_q - ref) / sum w_q (exact when all d_q are equal). Disparity
-  // replaces their depth, so sigma_range is in px. Their DBSCAN clustering variant is not
-  // implemented (the paper's BF* baseline is the plain filter).
+  // replaces their depth, so sigma_range is in px. Their DBSCAN clustering of the mask (an extra
+  // edge treatment) is not implemented: this is the plain filter, without occlusion handling.
   params.validate();
   const cv::Mat1f& sparse_d = sparse.disparity;
   requireDisparityMap(sparse_d, "upsampleBF");

@@ -50,7 +50,8 @@ Eigen::Isometry3d readExtrinsic(const cv::FileStorage& fs, const std::string& pa
   Eigen::Matrix4d e;
   cv::cv2eigen(m, e);
   const Eigen::Matrix3d r = e.topLeftCorner<3, 3>();
-  const double orthogonality = (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orthogonality =
+      (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   const bool last_row_ok = (e.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() < 1e-9;
   if (orthogonality > 1e-4 || std::abs(r.determinant() - 1.0) > 1e-4 || !last_row_ok) {
     throw std::runtime_error(where(path, "CameraExtrinsicMat") +

@@ -92,7 +92,8 @@ Eigen::Matrix<double, Rows, Cols> readMatrix(const KeyValueFile& file, const std
 }
 
 void requireRotation(const Eigen::Matrix3d& r, const std::string& file, const std::string& key) {
-  const double orthogonality = (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orthogonality =
+      (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (orthogonality > 1e-4 || std::abs(r.determinant() - 1.0) > 1e-4) {
     throw std::runtime_error("KITTI calibration: " + file + " key '" + key +
                              "' is not a rotation matrix");
@@ -102,8 +103,8 @@ void requireRotation(const Eigen::Matrix3d& r, const std::string& file, const st
 /// P = K [I | t]: checks K is an upper-triangular pinhole matrix with fx, fy > 0.
 void requireRectifiedProjection(const Eigen::Matrix<double, 3, 4>& p, const std::string& file,
                                 const std::string& key) {
-  const bool pinhole = p(0, 0) > 0 && p(1, 1) > 0 && p(1, 0) == 0 && p(2, 0) == 0 &&
-                       p(2, 1) == 0 && p(2, 2) == 1.0;
+  const bool pinhole =
+      p(0, 0) > 0 && p(1, 1) > 0 && p(1, 0) == 0 && p(2, 0) == 0 && p(2, 1) == 0 && p(2, 2) == 1.0;
   if (!pinhole) {
     throw std::runtime_error("KITTI calibration: " + file + " key '" + key +
                              "' is not a rectified projection K [I | t] with fx, fy > 0");
@@ -184,7 +185,8 @@ bool parseTimestamp(const std::string& line, double& seconds) {
       scale *= 0.1;
     }
   }
-  const int64_t days = daysFromCivil(year, static_cast<unsigned>(month), static_cast<unsigned>(day));
+  const int64_t days =
+      daysFromCivil(year, static_cast<unsigned>(month), static_cast<unsigned>(day));
   seconds = static_cast<double>(days * 86400 + hour * 3600 + minute * 60 + second) + fraction;
   return true;
 }
@@ -318,14 +320,13 @@ FrameData loadFrame(const Frame& frame, const StereoCamera& camera) {
   data.left = readColorImage(frame.left_image);
   data.right = readColorImage(frame.right_image);
   if (data.left.size() != data.right.size()) {
-    throw std::runtime_error("KITTI: frame " + frame.name + ": image sizes differ: " +
-                             frame.left_image + " is " + std::to_string(data.left.cols) + "x" +
-                             std::to_string(data.left.rows) + ", " + frame.right_image + " is " +
-                             std::to_string(data.right.cols) + "x" +
-                             std::to_string(data.right.rows));
+    throw std::runtime_error("KITTI: frame " + frame.name +
+                             ": image sizes differ: " + frame.left_image + " is " +
+                             std::to_string(data.left.cols) + "x" + std::to_string(data.left.rows) +
+                             ", " + frame.right_image + " is " + std::to_string(data.right.cols) +
+                             "x" + std::to_string(data.right.rows));
   }
-  if (camera.width > 0 &&
-      (data.left.cols != camera.width || data.left.rows != camera.height)) {
+  if (camera.width > 0 && (data.left.cols != camera.width || data.left.rows != camera.height)) {
     throw std::runtime_error("KITTI: frame " + frame.name + ": image " + frame.left_image + " is " +
                              std::to_string(data.left.cols) + "x" + std::to_string(data.left.rows) +
                              " but the calibration (S_rect_02) says " +

@@ -81,6 +81,20 @@ void visitSections(F& params, S& section) {
 
 // ---- Reading --------------------------------------------------------------------------------
 
+/// A string scalar without a trailing "# comment": OpenCV's YAML reader keeps comments after
+/// unquoted string values ("slanted: true  # note" reads as "true  # note").
+std::string scalarString(const cv::FileNode& node) {
+  std::string s = node.string();
+  for (size_t i = 1; i < s.size(); ++i) {
+    if (s[i] == '#' && (s[i - 1] == ' ' || s[i - 1] == '\t')) {
+      s.resize(i);
+      break;
+    }
+  }
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.pop_back();
+  return s;
+}
+
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
@@ -134,7 +148,7 @@ class FieldReader {
       value = v == 1;
       return;
     }
-    const std::string s = node.isString() ? lower(node.string()) : std::string();
+    const std::string s = node.isString() ? lower(scalarString(node)) : std::string();
     if (s == "true") {
       value = true;
     } else if (s == "false") {
@@ -152,7 +166,7 @@ class FieldReader {
       return;
     }
     // Values beyond int32 have to be quoted (FileStorage has no 64-bit integers).
-    const std::string s = node.isString() ? node.string() : std::string();
+    const std::string s = node.isString() ? scalarString(node) : std::string();
     if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos) {
       fail(key, "must be a non-negative integer");
     }
@@ -197,9 +211,10 @@ cv::FileStorage openYaml(const std::string& path) {
 }
 
 void readMethod(const cv::FileNode& node, const std::string& path, Method& method) {
-  if (!node.isString()) throw std::runtime_error("params YAML " + path + ": key 'method' must be a name");
+  if (!node.isString())
+    throw std::runtime_error("params YAML " + path + ": key 'method' must be a name");
   try {
-    method = parseMethod(node.string());
+    method = parseMethod(scalarString(node));
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error("params YAML " + path + ": key 'method': " + e.what());
   }

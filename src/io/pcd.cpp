@@ -2,6 +2,7 @@
 #include "lidar_stereo_fusion/io/pcd.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -31,11 +32,21 @@ std::vector<std::string> splitWords(const std::string& text) {
 
 long long parseInteger(const std::string& path, const std::string& key, const std::string& text) {
   char* end = nullptr;
+  errno = 0;
   const long long value = std::strtoll(text.c_str(), &end, 10);
-  if (end == text.c_str() || *end != '\0') {
+  if (end == text.c_str() || *end != '\0' || errno == ERANGE) {
     fail(path, "header " + key + " has a non-integer value '" + text + "'");
   }
   return value;
+}
+
+/// An int-sized header value (SIZE, COUNT, WIDTH, HEIGHT) in [0, INT_MAX].
+int parseCount(const std::string& path, const std::string& key, const std::string& text) {
+  const long long value = parseInteger(path, key, text);
+  if (value < 0 || value > std::numeric_limits<int>::max()) {
+    fail(path, "header " + key + " value " + text + " is out of range");
+  }
+  return static_cast<int>(value);
 }
 
 /// Parses header lines up to and including DATA; leaves `in` at the first data byte.
@@ -54,8 +65,7 @@ Header readHeader(std::istream& in, const std::string& path) {
     } else if (key == "FIELDS" || key == "COLUMNS") {
       header.fields = values;
     } else if (key == "SIZE") {
-      for (const auto& v : values)
-        header.sizes.push_back(static_cast<int>(parseInteger(path, key, v)));
+      for (const auto& v : values) header.sizes.push_back(parseCount(path, key, v));
     } else if (key == "TYPE") {
       for (const auto& v : values) {
         if (v.size() != 1 || (v[0] != 'F' && v[0] != 'I' && v[0] != 'U')) {
@@ -64,12 +74,11 @@ Header readHeader(std::istream& in, const std::string& path) {
         header.types.push_back(v[0]);
       }
     } else if (key == "COUNT") {
-      for (const auto& v : values)
-        header.counts.push_back(static_cast<int>(parseInteger(path, key, v)));
+      for (const auto& v : values) header.counts.push_back(parseCount(path, key, v));
     } else if (key == "WIDTH" && values.size() == 1) {
-      header.width = static_cast<int>(parseInteger(path, key, values[0]));
+      header.width = parseCount(path, key, values[0]);
     } else if (key == "HEIGHT" && values.size() == 1) {
-      header.height = static_cast<int>(parseInteger(path, key, values[0]));
+      header.height = parseCount(path, key, values[0]);
     } else if (key == "POINTS" && values.size() == 1) {
       const long long points = parseInteger(path, key, values[0]);
       if (points < 0) fail(path, "header POINTS is negative");
@@ -95,9 +104,11 @@ Header readHeader(std::istream& in, const std::string& path) {
       fail(path, "field '" + header.fields[i] + "' has unsupported TYPE " +
                      std::string(1, header.types[i]) + " with SIZE " + std::to_string(size));
     }
-    if (header.counts[i] < 1) fail(path, "field '" + header.fields[i] + "' has COUNT < 1");
+    if (header.counts[i] < 1 || header.counts[i] > (1 << 20)) {
+      fail(path, "field '" + header.fields[i] + "' has COUNT " + std::to_string(header.counts[i]) +
+                     " (expected 1 .. 2^20)");
+    }
   }
-  if (header.width < 0 || header.height < 0) fail(path, "header WIDTH/HEIGHT is negative");
   if (header.height == 0) header.height = 1;
   const std::size_t grid = static_cast<std::size_t>(header.width) * header.height;
   if (!have_points) header.points = grid;
@@ -188,8 +199,23 @@ LidarPoint makePoint(const Layout& layout, Getter value) {
   return point;
 }
 
+/// Bytes from the current position of `in` to its end.
+std::size_t remainingBytes(std::istream& in) {
+  const std::streampos here = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streampos end = in.tellg();
+  in.seekg(here);
+  return here < 0 || end < here ? 0 : static_cast<std::size_t>(end - here);
+}
+
 LidarCloud readBinary(std::istream& in, const Header& header, const Layout& layout,
                       const std::string& path) {
+  const std::size_t available = remainingBytes(in);
+  if (header.points > available / layout.stride) {
+    fail(path, "binary data is truncated: " + std::to_string(header.points) + " points of " +
+                   std::to_string(layout.stride) + " bytes need more than the " +
+                   std::to_string(available) + " bytes left");
+  }
   std::vector<unsigned char> bytes(header.points * layout.stride);
   in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   if (static_cast<std::size_t>(in.gcount()) != bytes.size()) {
@@ -211,7 +237,8 @@ LidarCloud readBinary(std::istream& in, const Header& header, const Layout& layo
 LidarCloud readAscii(std::istream& in, const Header& header, const Layout& layout,
                      const std::string& path) {
   LidarCloud cloud;
-  cloud.reserve(header.points);
+  // Every value takes at least two characters ("0 "): never reserve more than the file can hold.
+  cloud.reserve(std::min(header.points, remainingBytes(in) / (2 * layout.tokens)));
   std::vector<double> numbers(layout.tokens);
   std::string line;
   while (cloud.size() < header.points && std::getline(in, line)) {

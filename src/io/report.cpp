@@ -29,30 +29,28 @@ std::string separator(size_t columns) {
 }
 
 double nowSeconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 }  // namespace
 
 std::string formatDepthTable(const std::vector<DepthRow>& rows) {
-  const std::vector<std::string> header = {"",       "MAE mm", "RMSE mm", "iMAE 1/km",
+  const std::vector<std::string> header = {"",           "MAE mm",  "RMSE mm", "iMAE 1/km",
                                            "iRMSE 1/km", ">2 px %", ">3 px %", ">5 px %",
                                            "coverage %", "pixels"};
   std::string out = row(header) + separator(header.size());
   for (const DepthRow& r : rows) {
     const DepthMetrics& m = r.metrics;
-    out += row({r.name, format("%.0f", m.mae_mm), format("%.0f", m.rmse_mm),
-                format("%.2f", m.imae_per_km), format("%.2f", m.irmse_per_km),
-                format("%.2f", 100 * m.bad2), format("%.2f", 100 * m.bad3),
-                format("%.2f", 100 * m.bad5), format("%.1f", 100 * m.coverage),
-                std::to_string(m.count)});
+    out += row(
+        {r.name, format("%.0f", m.mae_mm), format("%.0f", m.rmse_mm), format("%.2f", m.imae_per_km),
+         format("%.2f", m.irmse_per_km), format("%.2f", 100 * m.bad2), format("%.2f", 100 * m.bad3),
+         format("%.2f", 100 * m.bad5), format("%.1f", 100 * m.coverage), std::to_string(m.count)});
   }
   return out;
 }
 
 std::string formatDisparityTable(const std::vector<DisparityRow>& rows) {
-  const std::vector<std::string> header = {"",        "MAE px",  "RMSE px", ">1 px %",  ">2 px %",
+  const std::vector<std::string> header = {"",        "MAE px",  "RMSE px",    ">1 px %", ">2 px %",
                                            ">3 px %", ">5 px %", "coverage %", "pixels"};
   std::string out = row(header) + separator(header.size());
   for (const DisparityRow& r : rows) {
@@ -120,8 +118,8 @@ void ProgressBar::update(int done, const std::string& note) {
   if (filled < width_) bar += '>';
   bar.resize(static_cast<size_t>(width_), ' ');
   const double elapsed = nowSeconds() - start_s_;
-  std::string line = "[" + bar + "] " + std::to_string(clamped) + "/" + std::to_string(total_) +
-                     " " + note;
+  std::string line =
+      "[" + bar + "] " + std::to_string(clamped) + "/" + std::to_string(total_) + " " + note;
   if (clamped > 0) line += "  " + format("%.2f", elapsed / clamped) + " s/frame";
   if (interactive_) {
     out_ << "\r" << line << "\033[K" << std::flush;  // \033[K clears the rest of the line

@@ -55,7 +55,7 @@ geometry_msgs::TransformStamped autowareLidarToCamera(const AutowareCalibration&
                                                       const std::string& camera_frame,
                                                       const ros::Time& stamp) {
   // CameraExtrinsicMat is already the camera pose in the LiDAR frame (= T_parent_child).
-  return transformMsg(calib.T_lidar_cam.inverse(), lidar_frame, camera_frame, stamp);
+  return transformMsg(calib.T_lidar_cam, lidar_frame, camera_frame, stamp);
 }
 
 geometry_msgs::TransformStamped kittiVelodyneToCamera(const kitti::Calibration& calib,
@@ -64,7 +64,7 @@ geometry_msgs::TransformStamped kittiVelodyneToCamera(const kitti::Calibration& 
                                                       const ros::Time& stamp) {
   // T_cam_velo maps Velodyne points into the camera; the camera pose in the Velodyne frame
   // (T_parent_child with parent = velodyne) is its inverse.
-  return transformMsg(calib.T_cam_velo, velodyne_frame, camera_frame, stamp);
+  return transformMsg(calib.T_cam_velo.inverse(), velodyne_frame, camera_frame, stamp);
 }
 
 geometry_msgs::TransformStamped stereoLeftToRight(const StereoCamera& camera,

@@ -66,7 +66,7 @@ cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg) {
   const std::string& e = msg->encoding;
   cv::Mat out;
   if (e == enc::BGR8 || e == enc::MONO8) {
-    out = shared->image;  // shares the message's memory (documented in the header)
+    out = shared->image.clone();  // own the pixels: the message may go before the result
   } else if (e == enc::BGRA8) {
     cv::cvtColor(shared->image, out, cv::COLOR_BGRA2BGR);
   } else if (e == enc::RGBA8) {

@@ -137,7 +137,7 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
   }
 
   // Live parameters: start from the values just read, then follow dynamic_reconfigure.
-  reconfigure_server_ = std::make_unique<dynamic_reconfigure::Server<FusionConfig>>(pnh_);
+  reconfigure_server_ = std::make_unique<dynamic_reconfigure::Server<FusionConfig>>(reconfigure_mutex_, pnh_);
   reconfigure_server_->updateConfig(ros_params::toConfig(params_));
   reconfigure_server_->setCallback(
       boost::bind(&FusionWorker::reconfigureCb, this, boost::placeholders::_1,
@@ -314,6 +314,7 @@ bool FusionWorker::checkImageSet(const ImageSet& set) {
 
 void FusionWorker::imageCb(const ImageConstPtr& left, const InfoConstPtr& left_info,
                            const ImageConstPtr& right, const InfoConstPtr& right_info) {
+  ROS_DEBUG_STREAM("[" << name_ << "] image set " << stampText(left->header.stamp));
   ImageSet set{left, right, left_info, right_info};
   if (!checkImageSet(set)) return;
   const ros::Time stamp = left->header.stamp;
@@ -344,6 +345,8 @@ void FusionWorker::syncDropCb(const ImageConstPtr& left, const InfoConstPtr& lef
 
 void FusionWorker::cloudCb(const CloudConstPtr& cloud) {
   const ros::Time stamp = cloud->header.stamp;
+  ROS_DEBUG_STREAM("[" << name_ << "] sweep " << stampText(stamp) << " (" << cloud->width * cloud->height
+                       << " points)");
   std::string problem = conversions::checkCloudLayout(*cloud);
   if (problem.empty() && cloud->width * cloud->height == 0) problem = "empty cloud (0 points)";
   if (problem.empty() && cloud->header.frame_id.empty()) problem = "empty frame_id";
@@ -378,6 +381,8 @@ void FusionWorker::handleEvents(Matcher::Events& events, const std::string& topi
                                      "~max_time_offset if the clocks differ)");
   }
   if (events.ready.empty()) return;
+  ROS_DEBUG_STREAM("[" << name_ << "] matched image set " << stampText(events.ready.back().image_stamp)
+                       << " with sweep " << stampText(events.ready.back().sweep_stamp));
   // Only the newest set is worth processing: older ones (and a set still waiting for the worker)
   // are dropped and counted, so a slow pipeline never builds a backlog.
   const std::size_t superseded = events.ready.size() - 1 + (next_job_ ? 1 : 0);
@@ -516,6 +521,8 @@ void FusionWorker::processMatch(const Match& match, FusionPipeline& pipeline) {
                   true);
     return;
   }
+  ROS_DEBUG_STREAM("[" << name_ << "] processed " << stampText(match.image_stamp) << " in "
+                       << result.stats.total_ms << " ms");
   publishOutputs(match, input.camera, input.left, result, pipeline.params(),
                  static_cast<int>(input.cloud.size()), rings, rings_recovered,
                  conversion_ms);

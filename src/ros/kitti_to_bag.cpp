@@ -35,7 +35,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <optional>
 #include <set>
@@ -140,31 +139,16 @@ Options parseOptions(int argc, char** argv) {
   }
   if (options.drive_dir.empty()) throw UsageError("--kitti-raw is required");
   if (options.out.empty()) throw UsageError("--out is required");
-  if (options.calib_dir.empty()) {
-    fs::path drive(options.drive_dir);
-    if (!drive.has_filename()) drive = drive.parent_path();  // trailing slash
-    options.calib_dir = drive.has_parent_path() ? drive.parent_path().string() : ".";
-  }
+  if (options.calib_dir.empty()) options.calib_dir = lsf::kitti::calibrationDirOf(options.drive_dir);
   return options;
 }
 
-/// Timestamps [s] of a KITTI timestamps file indexed by frame (= line) number; blank lines (a
-/// dropped sample) give std::nullopt. Parsing is kitti::readTimestamps's, which skips blanks.
+/// Timestamps [s] of a KITTI timestamps file indexed by frame (= line) number; a blank line (a
+/// dropped sample, NaN from kitti::readTimestamps) gives std::nullopt.
 std::vector<std::optional<double>> readTimestampsByFrame(const fs::path& path) {
-  const std::vector<double> stamps = lsf::kitti::readTimestamps(path.string());
-  std::ifstream in(path);
   std::vector<std::optional<double>> by_frame;
-  size_t next = 0;
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos) {
-      by_frame.emplace_back();
-    } else if (next < stamps.size()) {
-      by_frame.emplace_back(stamps[next++]);
-    }
-  }
-  if (next != stamps.size()) {
-    throw std::runtime_error("KITTI: " + path.string() + " changed while being read");
+  for (const double stamp : lsf::kitti::readTimestamps(path.string())) {
+    by_frame.push_back(std::isfinite(stamp) ? std::optional<double>(stamp) : std::nullopt);
   }
   return by_frame;
 }
@@ -286,9 +270,6 @@ boost::shared_ptr<ros::M_string> latchedConnectionHeader() {
 /// Chooses the frames to write and their stamps; prints what is skipped and why.
 std::vector<FrameToWrite> selectFrames(const Options& options) {
   const fs::path drive(options.drive_dir);
-  if (!fs::is_directory(drive)) {
-    throw std::runtime_error("KITTI: --kitti-raw " + options.drive_dir + " is not a folder");
-  }
   const std::vector<lsf::kitti::Frame> complete = lsf::kitti::listFrames(options.drive_dir);
 
   // Report files that cannot form a frame (e.g. LiDAR-only frames between the stereo frames).
@@ -439,6 +420,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    if (!fs::is_directory(options.drive_dir)) {
+      throw std::runtime_error("KITTI: --kitti-raw " + options.drive_dir + " is not a folder");
+    }
     const lsf::kitti::Calibration calib = lsf::kitti::readCalibration(options.calib_dir);
     const std::vector<FrameToWrite> frames = selectFrames(options);
     writeBag(options, calib, frames);

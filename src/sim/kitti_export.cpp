@@ -93,8 +93,9 @@ std::string timestamp(const std::string& date, double seconds) {
 
 void validateOptions(const KittiExportOptions& o) {
   const std::string& d = o.date;
-  const bool date_ok = d.size() == 10 && d[4] == '_' && d[7] == '_' &&
-                       std::all_of(d.begin(), d.end(), [](char c) { return c == '_' || std::isdigit(c); });
+  const bool date_ok =
+      d.size() == 10 && d[4] == '_' && d[7] == '_' &&
+      std::all_of(d.begin(), d.end(), [](char c) { return c == '_' || std::isdigit(c); });
   if (!date_ok) throw std::invalid_argument("KITTI export: date must be YYYY_MM_DD, got " + d);
   if (o.drive < 0 || o.drive > 9999) throw std::invalid_argument("KITTI export: drive 0..9999");
   if (o.num_frames < 1) throw std::invalid_argument("KITTI export: num_frames must be >= 1");

@@ -37,8 +37,8 @@ void castRing(const Scene& scene, const LidarModel& model, const Eigen::Isometry
     // A surface closer than min_range blocks the beam (no return), it is not looked through.
     if (!scene.intersect(origin, dir_world, 0.0, model.max_range, &hit)) continue;
     if (hit.t < model.min_range) continue;
-    const uint64_t key = hashCombine(noise.seed, static_cast<uint64_t>(ring),
-                                     static_cast<uint64_t>(j));
+    const uint64_t key =
+        hashCombine(noise.seed, static_cast<uint64_t>(ring), static_cast<uint64_t>(j));
     if (noise.dropout_probability > 0.0 &&
         unitFromHash(hashCombine(key, 1)) < noise.dropout_probability) {
       continue;
@@ -73,10 +73,10 @@ LidarModel LidarModel::hdl64() {
 
 LidarModel LidarModel::vls128() {
   LidarModel m;
-  appendLinear(m.elevations_deg, 15.0, 4.2, 10);   // 1.2 deg apart
-  appendLinear(m.elevations_deg, 3.4, 1.3, 8);     // 0.3 deg apart
-  appendLinear(m.elevations_deg, 1.0, -7.69, 80);  // 0.11 deg apart around the horizon
-  appendLinear(m.elevations_deg, -8.3, -25.0, 30); // ~0.58 deg apart
+  appendLinear(m.elevations_deg, 15.0, 4.2, 10);    // 1.2 deg apart
+  appendLinear(m.elevations_deg, 3.4, 1.3, 8);      // 0.3 deg apart
+  appendLinear(m.elevations_deg, 1.0, -7.69, 80);   // 0.11 deg apart around the horizon
+  appendLinear(m.elevations_deg, -8.3, -25.0, 30);  // ~0.58 deg apart
   m.azimuth_step_deg = 0.2;
   m.max_range = 200.0;
   return m;
@@ -85,8 +85,10 @@ LidarModel LidarModel::vls128() {
 LidarModel LidarModel::forRings(int rings) {
   if (rings == 64) return hdl64();
   if (rings == 128) return vls128();
-  throw std::invalid_argument("sim::LidarModel: rings must be 64 (HDL-64E-like) or 128 "
-                              "(VLS-128-like), got " + std::to_string(rings));
+  throw std::invalid_argument(
+      "sim::LidarModel: rings must be 64 (HDL-64E-like) or 128 "
+      "(VLS-128-like), got " +
+      std::to_string(rings));
 }
 
 void LidarModel::validate() const {

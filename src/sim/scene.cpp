@@ -253,8 +253,8 @@ bool Scene::intersectPrimitive(int index, const Eigen::Vector3d& origin,
   return intersectCylinder(std::get<CylinderShape>(shape), origin, direction, t_min, t_max, hit);
 }
 
-bool Scene::intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                      double t_min, double t_max, Hit* hit) const {
+bool Scene::intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double t_min,
+                      double t_max, Hit* hit) const {
   const Eigen::Vector3d inv_dir = direction.cwiseInverse();
   bool found = false;
   Hit candidate;
@@ -291,14 +291,24 @@ uint64_t Scene::surfaceSeed(int primitive) const {
   return hashCombine(texture_seed_, static_cast<uint64_t>(primitive));
 }
 
+double Scene::pixelFootprint(const Hit& hit, const Eigen::Vector3d& filter_centre,
+                             double focal_px) {
+  const Eigen::Vector3d to_point = hit.point - filter_centre;
+  const double distance = to_point.norm();
+  if (!(distance > 0.0)) return 0.0;
+  const Eigen::Vector3d ray = to_point / distance;
+  const double cos_axis = std::max(ray.z(), 0.1);  // off-axis angle
+  const double cos_incidence = std::max(std::abs(hit.normal.dot(ray)), 0.05);
+  return distance * cos_axis / focal_px * std::sqrt(cos_axis / cos_incidence);
+}
+
 Eigen::Vector3d Scene::radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                                double pixel_angle_rad) const {
+                                const Eigen::Vector3d& filter_centre, double focal_px) const {
   Hit hit;
   if (!intersect(origin, direction, 0.0, kInf, &hit)) return skyColour(direction);
-  const double cos_incidence = std::max(std::abs(hit.normal.dot(direction)), 0.1);
-  const double footprint = hit.t * pixel_angle_rad / cos_incidence;
   const Eigen::Vector3d albedo =
-      texturedAlbedo(materials_[hit.material], hit.uv, footprint, surfaceSeed(hit.primitive));
+      texturedAlbedo(materials_[hit.material], hit.uv, pixelFootprint(hit, filter_centre, focal_px),
+                     surfaceSeed(hit.primitive));
   const Eigen::Vector3d& sun = lighting.sun_direction;
   double direct = std::max(0.0, hit.normal.dot(sun));
   if (direct > 0.0 && lighting.shadows &&

@@ -75,8 +75,8 @@ class StreetBuilder {
 
   /// Box with footprint centre (x, z) [m], size across x / along z, vertical extent
   /// [bottom, top] above the ground [m], turned by `yaw` [rad], optionally tilted by `pitch`.
-  void box(double x, double z, double width, double length, double bottom, double top,
-           double yaw, int material, double pitch = 0.0) {
+  void box(double x, double z, double width, double length, double bottom, double top, double yaw,
+           int material, double pitch = 0.0) {
     const Eigen::Vector3d centre(x, ground_y_ - 0.5 * (bottom + top), z);
     const Eigen::Vector3d half(0.5 * width, 0.5 * (top - bottom), 0.5 * length);
     const Eigen::Matrix3d rotation =
@@ -92,7 +92,9 @@ class StreetBuilder {
   void car(double x, double z, double yaw, int paint, const Palette& p) {
     scene_.beginGroup();
     const Eigen::Matrix3d r = yawRotation(yaw);
-    auto at = [&](double lx, double lz) -> Eigen::Vector3d { return r * Eigen::Vector3d(lx, 0, lz); };
+    auto at = [&](double lx, double lz) -> Eigen::Vector3d {
+      return r * Eigen::Vector3d(lx, 0, lz);
+    };
     box(x, z, 1.8, 4.3, 0.3, 1.0, yaw, paint);
     const Eigen::Vector3d cabin = at(0.0, -0.2);
     box(x + cabin.x(), z + cabin.z(), 1.6, 2.3, 1.0, 1.5, yaw, p.glass);

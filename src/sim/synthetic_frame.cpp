@@ -25,11 +25,11 @@ Eigen::Vector3d pixelRay(const SyntheticParams& p, double x, double y) {
 
 /// One view: subsamples^2 rays per pixel on a regular grid, averaged in linear RGB, gamma,
 /// then Gaussian noise (a hash of seed, pixel and channel: identical for any thread count).
+/// Textures are pre-filtered for the left camera at `filter_centre` in both views.
 cv::Mat renderView(const Scene& scene, const SyntheticParams& p, const Eigen::Vector3d& centre,
-                   uint64_t noise_seed) {
+                   const Eigen::Vector3d& filter_centre, uint64_t noise_seed) {
   cv::Mat image(p.height, p.width, CV_8UC3);
   const int s = p.subsamples;
-  const double pixel_angle = 1.0 / p.fx;
 #pragma omp parallel for schedule(dynamic, 2)
   for (int y = 0; y < p.height; ++y) {
     auto* row = image.ptr<cv::Vec3b>(y);
@@ -38,7 +38,7 @@ cv::Mat renderView(const Scene& scene, const SyntheticParams& p, const Eigen::Ve
       for (int sy = 0; sy < s; ++sy) {
         for (int sx = 0; sx < s; ++sx) {
           const double ox = (sx + 0.5) / s - 0.5, oy = (sy + 0.5) / s - 0.5;
-          sum += scene.radiance(centre, pixelRay(p, x + ox, y + oy), pixel_angle);
+          sum += scene.radiance(centre, pixelRay(p, x + ox, y + oy), filter_centre, p.fx);
         }
       }
       const Eigen::Vector3d rgb = sum / (s * s);
@@ -58,8 +58,8 @@ cv::Mat renderView(const Scene& scene, const SyntheticParams& p, const Eigen::Ve
 
 /// Depth, disparity, the low-texture mask and the LiDAR field-of-view mask from the ray through
 /// each pixel centre.
-void renderGroundTruth(const Scene& scene, const SyntheticParams& p,
-                       const Eigen::Vector3d& centre, SyntheticFrame& frame) {
+void renderGroundTruth(const Scene& scene, const SyntheticParams& p, const Eigen::Vector3d& centre,
+                       SyntheticFrame& frame) {
   frame.depth = cv::Mat1f(p.height, p.width, 0.f);
   frame.disparity = cv::Mat1f(p.height, p.width, 0.f);
   frame.low_texture = cv::Mat1b(p.height, p.width, uint8_t{0});
@@ -154,8 +154,8 @@ StereoCamera SyntheticParams::camera() const {
 
 Eigen::Isometry3d SyntheticParams::cameraFromLidar() const {
   Eigen::Matrix3d r;  // columns: the LiDAR's x (forward), y (left), z (up) in optical axes
-  r << 0, -1, 0,  //
-      0, 0, -1,   //
+  r << 0, -1, 0,      //
+      0, 0, -1,       //
       1, 0, 0;
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.linear() = r;
@@ -182,8 +182,9 @@ SyntheticFrame renderFrame(const Scene& scene, const SyntheticParams& params, in
   frame.T_world_cam = Eigen::Translation3d(left_centre) * Eigen::Isometry3d::Identity();
 
   const uint64_t frame_seed = hashCombine(params.seed, static_cast<uint64_t>(index));
-  frame.left = renderView(scene, params, left_centre, hashCombine(frame_seed, 0x1ef7));
-  frame.right = renderView(scene, params, right_centre, hashCombine(frame_seed, 0x7197));
+  frame.left = renderView(scene, params, left_centre, left_centre, hashCombine(frame_seed, 0x1ef7));
+  frame.right =
+      renderView(scene, params, right_centre, left_centre, hashCombine(frame_seed, 0x7197));
   renderGroundTruth(scene, params, left_centre, frame);
 
   LidarNoise noise;

@@ -43,8 +43,8 @@ Eigen::Vector3d noisyAlbedo(const Eigen::Vector3d& albedo, double contrast, doub
   const double n = fractalNoise(uv.x(), uv.y(), wavelength, octaves, fp, seed);
   Eigen::Vector3d out;
   for (int c = 0; c < 3; ++c) {
-    const double tint =
-        fractalNoise(uv.x(), uv.y(), wavelength, std::min(octaves, 3), fp, hashCombine(seed, 17 + c));
+    const double tint = fractalNoise(uv.x(), uv.y(), wavelength, std::min(octaves, 3), fp,
+                                     hashCombine(seed, 17 + c));
     out[c] = albedo[c] * std::max(0.0, 1.0 + contrast * (n + 0.1 * tint));
   }
   return out;
@@ -75,16 +75,16 @@ Eigen::Vector3d roadAlbedo(const Material& m, const Eigen::Vector2d& uv, double 
 /// kFacade: wall noise, a darker plinth, and a grid of windows from the second floor up.
 Eigen::Vector3d facadeAlbedo(const Material& m, const Eigen::Vector2d& uv, double fp,
                              uint64_t seed) {
-  constexpr double kBay = 3.0, kFloor = 3.2;                  // [m] window grid
-  constexpr double kWindowLeft = 0.9, kWindowRight = 2.1;     // [m] within a bay
-  constexpr double kSillHeight = 1.0, kLintelHeight = 2.5;    // [m] within a floor
+  constexpr double kBay = 3.0, kFloor = 3.2;                      // [m] window grid
+  constexpr double kWindowLeft = 0.9, kWindowRight = 2.1;         // [m] within a bay
+  constexpr double kSillHeight = 1.0, kLintelHeight = 2.5;        // [m] within a floor
   constexpr double kFirstWindowFloor = 1.0, kPlinthHeight = 0.6;  // [m]
   const double u = uv.x(), height = uv.y();
   Eigen::Vector3d wall = noisyAlbedo(m.albedo, m.contrast, m.wavelength_m, m.octaves, uv, fp, seed);
   wall *= 1.0 - 0.4 * coverage(height, -1e9, kPlinthHeight, fp);
   const double window = periodicCoverage(u, kWindowLeft, kWindowRight, kBay, fp) *
-                  periodicCoverage(height, kSillHeight, kLintelHeight, kFloor, fp) *
-                  coverage(height, kFirstWindowFloor * kFloor, 1e9, fp);
+                        periodicCoverage(height, kSillHeight, kLintelHeight, kFloor, fp) *
+                        coverage(height, kFirstWindowFloor * kFloor, 1e9, fp);
   const Eigen::Vector3d glass =
       noisyAlbedo(Eigen::Vector3d(0.10, 0.12, 0.16), 0.6, 0.4, 4, uv, fp, hashCombine(seed, 2));
   return lerp(wall, glass, std::clamp(window, 0.0, 1.0));

@@ -49,13 +49,13 @@ TEST(RingHoldout, ReferenceDepthIsTheNearestZPerRoundedPixel) {
   // Identity transform: the LiDAR frame is the camera frame.
   const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
   const LidarCloud held = {
-      point(0.f, 0.f, 10.f, 1),      // u = 10, v = 5
-      point(0.048f, 0.f, 8.f, 1),    // u = 10.6 -> 11, v = 5
-      point(0.004f, 0.f, 9.f, 1),    // u = 10.04 -> 10: nearer than 10 m, wins
-      point(-0.2f, -0.1f, 2.f, 1),   // u = 0, v = 0
-      point(1.f, 0.f, 2.f, 1),       // u = 60: outside
-      point(0.f, 0.f, 0.2f, 1),      // nearer than min_depth 0.5
-      point(0.f, 0.f, -5.f, 1),      // behind
+      point(0.f, 0.f, 10.f, 1),     // u = 10, v = 5
+      point(0.048f, 0.f, 8.f, 1),   // u = 10.6 -> 11, v = 5
+      point(0.004f, 0.f, 9.f, 1),   // u = 10.04 -> 10: nearer than 10 m, wins
+      point(-0.2f, -0.1f, 2.f, 1),  // u = 0, v = 0
+      point(1.f, 0.f, 2.f, 1),      // u = 60: outside
+      point(0.f, 0.f, 0.2f, 1),     // nearer than min_depth 0.5
+      point(0.f, 0.f, -5.f, 1),     // behind
   };
   ProjectionParams params;
   const cv::Mat1f depth = projectReferenceDepth(held, identity, camera(), params);
@@ -79,7 +79,7 @@ TEST(RingHoldout, MakeRingHoldoutFeedsEvenRingsAndFailsWithoutReference) {
 
 TEST(PseudoLidar, EvenlySpacedRowsWithRingIdsAndOnlyKnownDisparities) {
   cv::Mat1f gt(8, 5, 3.f);
-  gt(1, 2) = 0.f;  // unknown: not sampled
+  gt(1, 2) = 0.f;                                               // unknown: not sampled
   const SparseDisparity sparse = sampleRowsAsScanLines(gt, 4);  // rows 1, 3, 5, 7
   for (int y = 0; y < 8; ++y) {
     for (int x = 0; x < 5; ++x) {
@@ -99,9 +99,9 @@ TEST(PseudoLidar, RightViewShiftsByTheRoundedDisparityAndTheNearerSampleWins) {
   left.ring = cv::Mat1s(1, 10, static_cast<int16_t>(-1));
   left.disparity(0, 5) = 2.4f;  // -> 2.6 -> 3
   left.ring(0, 5) = 7;
-  left.disparity(0, 7) = 4.f;   // -> 3: nearer, wins
+  left.disparity(0, 7) = 4.f;  // -> 3: nearer, wins
   left.ring(0, 7) = 8;
-  left.disparity(0, 1) = 3.f;   // -> -2: outside
+  left.disparity(0, 1) = 3.f;  // -> -2: outside
   const SparseDisparity right = shiftToRightView(left);
   EXPECT_EQ(right.disparity(0, 3), 4.f);
   EXPECT_EQ(right.ring(0, 3), 8);
@@ -131,11 +131,13 @@ TEST(Visualization, EmptyPixelsAreBlackAndTheScaleFollowsTheMaximum) {
   const cv::Mat error = colorizeError(est, ref, 5.0);
   EXPECT_EQ(error.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 0, 0));  // no reference
   // Missing estimate shows as the maximum error, like an error of 5 px.
-  EXPECT_EQ(error.at<cv::Vec3b>(0, 2),
-            colorizeError((cv::Mat1f(1, 1) << 15), (cv::Mat1f(1, 1) << 10), 5.0).at<cv::Vec3b>(0, 0));
+  EXPECT_EQ(
+      error.at<cv::Vec3b>(0, 2),
+      colorizeError((cv::Mat1f(1, 1) << 15), (cv::Mat1f(1, 1) << 10), 5.0).at<cv::Vec3b>(0, 0));
   EXPECT_THROW(colorizeError(est, cv::Mat1f(1, 2, 1.f)), std::invalid_argument);
 
-  const cv::Mat overlay = overlaySparse(cv::Mat(5, 5, CV_8UC3, cv::Scalar::all(100)), cv::Mat1f(5, 5, 0.f));
+  const cv::Mat overlay =
+      overlaySparse(cv::Mat(5, 5, CV_8UC3, cv::Scalar::all(100)), cv::Mat1f(5, 5, 0.f));
   EXPECT_EQ(overlay.at<cv::Vec3b>(2, 2), cv::Vec3b(40, 40, 40));  // darkened to 40 %
   EXPECT_THROW(overlaySparse(cv::Mat(5, 5, CV_8UC3), cv::Mat1f(4, 5)), std::invalid_argument);
 }

@@ -24,9 +24,8 @@ class TempDir {
  public:
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            ("lsf_kitti_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-             std::to_string(::getpid()));
+    path_ = fs::temp_directory_path() / ("lsf_kitti_" + std::string(info->test_suite_name()) + "_" +
+                                         info->name() + "_" + std::to_string(::getpid()));
     fs::remove_all(path_);
     fs::create_directories(path_);
   }
@@ -87,8 +86,7 @@ struct SyntheticCalib {
                   line("P_rect_02", join(projection(t2))) +
                   line("P_rect_03", join(projection(t3))) + line("S_rect_02", " 1242 375"));
     writeText(dir / "calib_velo_to_cam.txt", "calib_time: 15-Mar-2012 11:37:16\n" +
-                                                 line("R", join(r_velo)) +
-                                                 line("T", join(t_velo)));
+                                                 line("R", join(r_velo)) + line("T", join(t_velo)));
   }
 };
 
@@ -211,14 +209,14 @@ TEST(KittiVelodyne, SizeNotMultipleOf16AndMissingFileAreErrors) {
 TEST(KittiDepthPng, RoundTripQuantisesToOne256thMetreAndMarksNoValueWithZero) {
   TempDir dir;
   cv::Mat1f depth(2, 4, 0.f);
-  depth(0, 0) = 1.0f;                                       // 256
-  depth(0, 1) = 12.3456f;                                   // round(3160.47) = 3160
-  depth(0, 2) = std::numeric_limits<float>::quiet_NaN();    // none
-  depth(0, 3) = -2.f;                                       // none
-  depth(1, 0) = std::numeric_limits<float>::infinity();     // none
-  depth(1, 1) = 1000.f;                                     // saturates at 65535
-  depth(1, 2) = 0.001f;                                     // tiny but present: 1
-  depth(1, 3) = 80.0f;                                      // 20480
+  depth(0, 0) = 1.0f;                                     // 256
+  depth(0, 1) = 12.3456f;                                 // round(3160.47) = 3160
+  depth(0, 2) = std::numeric_limits<float>::quiet_NaN();  // none
+  depth(0, 3) = -2.f;                                     // none
+  depth(1, 0) = std::numeric_limits<float>::infinity();   // none
+  depth(1, 1) = 1000.f;                                   // saturates at 65535
+  depth(1, 2) = 0.001f;                                   // tiny but present: 1
+  depth(1, 3) = 80.0f;                                    // 20480
   const std::string path = (dir / "d.png").string();
   kitti::writeDepthPng(path, depth);
   const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
@@ -307,14 +305,15 @@ TEST(KittiFrames, CalibrationDirIsTheDriveParent) {
 TEST(KittiTimestamps, ParsedAsUtcSecondsWithNanosecondsEmptyLinesAreNan) {
   TempDir dir;
   const fs::path path = dir / "timestamps.txt";
-  writeText(path, "1970-01-01 00:00:01.500000000\n2011-09-26 13:02:25.964389445\n\n"
-                  "2000-02-29 23:59:59\n");
+  writeText(path,
+            "1970-01-01 00:00:01.500000000\n2011-09-26 13:02:25.964389445\n\n"
+            "2000-02-29 23:59:59\n");
   const std::vector<double> t = kitti::readTimestamps(path.string());
   ASSERT_EQ(t.size(), 4u);
   EXPECT_DOUBLE_EQ(t[0], 1.5);
   EXPECT_NEAR(t[1], 1317042145.0 + 0.964389445, 1e-6);  // calendar.timegm(2011, 9, 26, 13, 2, 25)
   EXPECT_TRUE(std::isnan(t[2]));                        // empty line: dropped sample
-  EXPECT_DOUBLE_EQ(t[3], 951868799.0);                   // leap day
+  EXPECT_DOUBLE_EQ(t[3], 951868799.0);                  // leap day
   writeText(path, "1970-01-01 00:00:01.5\n2011-09-26 13:02\n");
   try {
     kitti::readTimestamps(path.string());

@@ -60,8 +60,8 @@ TEST(DepthMetrics, BadPixelRatesUseDisparityAndStrictThresholds) {
   // Reference disparity 10 px everywhere (z = 10 m); estimates with disparity errors
   // 2.5, 3.5, 6 and 1.9 px.
   const cv::Mat1f reference(1, 4, 10.f);
-  const cv::Mat1f estimate = (cv::Mat1f(1, 4) << 100.f / 12.5f, 100.f / 13.5f, 100.f / 16.f,
-                              100.f / 11.9f);
+  const cv::Mat1f estimate =
+      (cv::Mat1f(1, 4) << 100.f / 12.5f, 100.f / 13.5f, 100.f / 16.f, 100.f / 11.9f);
   const DepthMetrics m = evaluateDepth(estimate, reference, camera(4, 1));
   EXPECT_DOUBLE_EQ(m.bad2, 0.75);
   EXPECT_DOUBLE_EQ(m.bad3, 0.5);

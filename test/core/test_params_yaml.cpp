@@ -167,6 +167,27 @@ TEST(ParamsYaml, PartialRosparamStyleFileOverridesOnlyWhatItNames) {
   expectSame(p, expected);
 }
 
+TEST(ParamsYaml, CommentsAfterStringAndBooleanValuesAreIgnored) {
+  YamlFile file(
+      "method: lidar_bf   # the baseline\n"
+      "patchmatch:\n"
+      "  slanted: false\t# front-parallel\n"
+      "  lr_check: true # keep\n"
+      "  seed: \"123\"  # quoted\n");
+  FusionParams p;
+  loadParamsYaml(file.path(), p);
+  EXPECT_EQ(p.method, Method::kLidarBF);
+  EXPECT_FALSE(p.patchmatch.slanted);
+  EXPECT_TRUE(p.patchmatch.lr_check);
+  EXPECT_EQ(p.patchmatch.seed, 123u);
+}
+
+TEST(ParamsYaml, TheShippedConfigLoadsAsTheDefaults) {
+  FusionParams p = everyFieldChanged();
+  loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/fusion.yaml", p);
+  expectSame(p, FusionParams());
+}
+
 TEST(ParamsYaml, OpenCvStyleFileWithDirectiveAndEmptyFileAreAccepted) {
   YamlFile with_directive("%YAML:1.0\n---\nbi:\n  max_gap_px: 5\n  search_lines: 1\n");
   FusionParams p;

@@ -141,6 +141,11 @@ TEST(Pcd, MalformedFilesThrowNamingTheProblem) {
   expectReadError(tempPath("noz.pcd"), "x, y and z");
   writeText(tempPath("trunc.pcd"), head + "WIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA binary\n12345678");
   expectReadError(tempPath("trunc.pcd"), "truncated");
+  writeText(tempPath("huge.pcd"),
+            head + "WIDTH 2000000000\nHEIGHT 1000\nPOINTS 2000000000000\nDATA binary\n1234");
+  expectReadError(tempPath("huge.pcd"), "truncated");
+  writeText(tempPath("overflow.pcd"), head + "WIDTH 99999999999999999999\nDATA ascii\n");
+  expectReadError(tempPath("overflow.pcd"), "WIDTH");
   writeText(tempPath("lzf.pcd"), head + "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA binary_compressed\n");
   expectReadError(tempPath("lzf.pcd"), "binary_compressed");
   writeText(tempPath("points.pcd"), head + "WIDTH 2\nHEIGHT 1\nPOINTS 3\nDATA ascii\n");

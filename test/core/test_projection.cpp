@@ -126,6 +126,16 @@ TEST(Projection, DropsPointsBehindOutsideDepthRangeAndNonFinite) {
   for (float v : s.disparity) EXPECT_TRUE(std::isfinite(v));
 }
 
+TEST(Projection, FarOffCoordinatesAreDroppedWithoutIntegerOverflow) {
+  const LidarCloud cloud = {point(1e30f, 0.f, 8.f), point(0.f, -1e30f, 8.f),
+                            point(-3e38f, 3e38f, 8.f)};
+  const SparseDisparity s =
+      projectCloud(cloud, Eigen::Isometry3d::Identity(), testCamera(), ProjectionParams());
+  EXPECT_EQ(s.points_in_front, 3);
+  EXPECT_EQ(s.points_in_image, 0);
+  EXPECT_EQ(countNonZero(s.disparity), 0);
+}
+
 TEST(Projection, AppliesTheLidarToCameraTransform) {
   // LiDAR axes x forward, y left, z up -> optical x right, y down, z forward, plus a translation.
   Eigen::Matrix3d R;

@@ -49,7 +49,7 @@ class SyntheticFusion : public ::testing::Test {
   static lsf::DepthMetrics score(lsf::Method method, const cv::Mat1b& mask = cv::Mat1b()) {
     cv::Mat1f reference = frame_->depth;
     if (!mask.empty()) {
-      reference = cv::Mat1f::zeros(frame_->depth.size());
+      reference = cv::Mat1f(frame_->depth.size(), 0.f);  // a new buffer, not the frame's
       frame_->depth.copyTo(reference, mask);
     }
     return lsf::evaluateDepth(results_->at(method).depth, reference, frame_->camera);
@@ -84,6 +84,10 @@ TEST_F(SyntheticFusion, FusedBIBeatsLidarOnlyAndPlainPmsInTheLidarFieldOfView) {
   EXPECT_LT(fused.rmse_mm, pms.rmse_mm) << "seed " << kSeed;
 }
 
+// On the whole image (sky excluded) only the bad-pixel rate is compared with PMS: above the top
+// beam the fused method is plain stereo with a small window, and the far facades there (60-100 m,
+// where 1 px of disparity is tens of metres) dominate the whole-image MAE; which method wins that
+// MAE depends on the seed. The demo prints both.
 TEST_F(SyntheticFusion, FusedBIHasFewerBadPixelsThanPlainPmsOnTheWholeImage) {
   const lsf::DepthMetrics fused = score(lsf::Method::kFusedBI);
   const lsf::DepthMetrics lidar = score(lsf::Method::kLidarBI);
@@ -105,18 +109,24 @@ TEST_F(SyntheticFusion, LidarCarriesTheDarkUntexturedRegion) {
   EXPECT_LE(fused.mae_mm, 0.5 * pms.mae_mm) << "seed " << kSeed;
 }
 
+// Counted over scan-line pixels that come from a LiDAR point the left camera cannot see. The
+// misses are by design of Algorithm 1's vertical search: background points just under the top edge
+// of an object (the LiDAR sits 8 cm above the camera, so no foreground lies above them) and points
+// behind thin vertical poles (horizontal parallax: their column holds no foreground line at all).
+// At 1242x375 those are a larger share and the same scene gives about 40 % removed.
 TEST_F(SyntheticFusion, Algorithm1RemovesMostOccludedPointsAndKeepsVisibleOnes) {
   const lsf::BIParams bi;
-  const lsf::SparseDisparity sparse = lsf::projectCloud(
-      frame_->cloud, frame_->T_cam_lidar, frame_->camera, lsf::ProjectionParams());
+  const lsf::SparseDisparity sparse = lsf::projectCloud(frame_->cloud, frame_->T_cam_lidar,
+                                                        frame_->camera, lsf::ProjectionParams());
   const lsf::ScanLines before = lsf::completeScanLines(sparse, bi);
   lsf::ScanLines after{before.disparity.clone(), before.ring.clone()};
   lsf::removeOccludedPoints(after, frame_->left, bi);
   const sim::OcclusionRemovalScore s = sim::scoreOcclusionRemoval(*frame_, before, after);
-  std::printf("  Algorithm 1: removed %d of %d occluded points (%.1f %%), kept %d of %d visible "
-              "(%.2f %%)\n",
-              s.occluded_removed, s.occluded, 100 * s.removedFraction(), s.visible_kept,
-              s.visible, 100 * s.keptFraction());
+  std::printf(
+      "  Algorithm 1: removed %d of %d occluded points (%.1f %%), kept %d of %d visible "
+      "(%.2f %%)\n",
+      s.occluded_removed, s.occluded, 100 * s.removedFraction(), s.visible_kept, s.visible,
+      100 * s.keptFraction());
   ASSERT_GT(s.occluded, 100) << "seed " << kSeed << ": the scene must produce occlusion artefacts";
   EXPECT_GT(s.removedFraction(), 0.5) << "seed " << kSeed;
   EXPECT_GT(s.keptFraction(), 0.95) << "seed " << kSeed;

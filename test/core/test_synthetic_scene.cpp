@@ -169,7 +169,8 @@ TEST(SyntheticScene, LidarPointsLieOnSurfacesAlongTheirBeams) {
       const double tolerance = 1e-6 * range + 1e-5;  // float coordinates
       const bool on_ground = std::abs(w.y() - height) < tolerance;
       const bool on_wall = std::abs(w.z() - wall_z) < tolerance;
-      ASSERT_TRUE(on_ground || on_wall) << rings << " rings, point " << i << " at " << w.transpose();
+      ASSERT_TRUE(on_ground || on_wall)
+          << rings << " rings, point " << i << " at " << w.transpose();
       ASSERT_GE(pt.ring, 0);
       ASSERT_LT(pt.ring, rings);
       const double elevation = std::atan2(pt.z, std::hypot(pt.x, pt.y)) * 180.0 / M_PI;
@@ -276,8 +277,8 @@ TEST(SyntheticScene, DeterministicBySeedAndThreadCount) {
   exact.seed = 11;
   exact.dropout_probability = 0.0;
   exact.range_noise_sigma = 0.0;
-  const double kept = static_cast<double>(a.cloud.size()) /
-                      sim::generateStreetFrame(exact, 1).cloud.size();
+  const double kept =
+      static_cast<double>(a.cloud.size()) / sim::generateStreetFrame(exact, 1).cloud.size();
   EXPECT_NEAR(kept, 0.95, 0.01) << "seed 11";
 }
 
@@ -304,8 +305,7 @@ TEST(SyntheticScene, KittiExportReadsBackWithTheKittiReader) {
   EXPECT_NEAR(calib.camera.baseline, expected.baseline, 1e-6);
   EXPECT_EQ(calib.camera.width, expected.width);
   EXPECT_EQ(calib.camera.height, expected.height);
-  EXPECT_LT((calib.T_cam_velo.matrix() - p.cameraFromLidar().matrix()).cwiseAbs().maxCoeff(),
-            1e-6);
+  EXPECT_LT((calib.T_cam_velo.matrix() - p.cameraFromLidar().matrix()).cwiseAbs().maxCoeff(), 1e-6);
 
   const std::vector<lsf::kitti::Frame> frames = lsf::kitti::listFrames(drive);
   ASSERT_EQ(frames.size(), 2u);
@@ -321,9 +321,10 @@ TEST(SyntheticScene, KittiExportReadsBackWithTheKittiReader) {
       // The .bin stores lasers in KITTI's order, so the sweep-order rule recovers our rings.
       ASSERT_EQ(data.cloud[k].ring, f.cloud[k].ring) << "frame " << i << " point " << k;
     }
-    const cv::Mat1f depth = lsf::kitti::readDepthPng(
-        (std::filesystem::path(drive) / "proj_depth/groundtruth/image_02" / (frames[i].name + ".png"))
-            .string());
+    const cv::Mat1f depth =
+        lsf::kitti::readDepthPng((std::filesystem::path(drive) / "proj_depth/groundtruth/image_02" /
+                                  (frames[i].name + ".png"))
+                                     .string());
     for (int v = 0; v < depth.rows; ++v) {
       for (int u = 0; u < depth.cols; ++u) {
         ASSERT_NEAR(depth(v, u), f.depth(v, u), 1.0 / 512 + 1e-6) << "seed " << seed;

@@ -383,6 +383,11 @@ TEST(UpsampleBF, RejectsInvalidParamsAndInput) {
   params = BFParams();
   params.radius = -1;
   EXPECT_THROW(upsampleBF(s, params), std::invalid_argument);
+  params.radius = 100000;
+  EXPECT_THROW(upsampleBF(s, params), std::invalid_argument);
+  params = BFParams();
+  params.sigma_range = 1e-320;
+  EXPECT_THROW(upsampleBF(s, params), std::invalid_argument);
   SparseDisparity nan = emptySparse(10, 10);
   nan.disparity(2, 2) = std::numeric_limits<float>::quiet_NaN();
   EXPECT_THROW(upsampleBF(nan, BFParams()), std::invalid_argument);

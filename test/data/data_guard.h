@@ -25,14 +25,14 @@ inline bool runningUnderCi() {
 }  // namespace lidar_stereo_fusion
 
 /// Fails (CI=true) or skips the current test when LSF_DATA_DIR/`relative` does not exist.
-#define LSF_REQUIRE_DATA(relative)                                                          \
-  do {                                                                                      \
-    const std::string lsf_path_ = ::lidar_stereo_fusion::test::dataPath(relative);          \
-    if (!std::filesystem::exists(lsf_path_)) {                                              \
-      if (::lidar_stereo_fusion::test::runningUnderCi()) {                                  \
-        FAIL() << "missing test data " << lsf_path_ << " (CI=true: data is required)";      \
-      } else {                                                                              \
-        GTEST_SKIP() << "missing test data " << lsf_path_ << " (set CI=true to fail)";      \
-      }                                                                                     \
-    }                                                                                       \
+#define LSF_REQUIRE_DATA(relative)                                                     \
+  do {                                                                                 \
+    const std::string lsf_path_ = ::lidar_stereo_fusion::test::dataPath(relative);     \
+    if (!std::filesystem::exists(lsf_path_)) {                                         \
+      if (::lidar_stereo_fusion::test::runningUnderCi()) {                             \
+        FAIL() << "missing test data " << lsf_path_ << " (CI=true: data is required)"; \
+      } else {                                                                         \
+        GTEST_SKIP() << "missing test data " << lsf_path_ << " (set CI=true to fail)"; \
+      }                                                                                \
+    }                                                                                  \
   } while (0)

@@ -1,6 +1,6 @@
 // Autoware camera-LiDAR calibration files: the real calibrator outputs in
-// ../shared/data/autoware_calibration prove the extrinsic's direction through their CalibData pairs;
-// small synthetic files check the projection formula and the error messages.
+// ../shared/data/autoware_calibration prove the extrinsic's direction through their CalibData
+// pairs; small synthetic files check the projection formula and the error messages.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -96,14 +96,15 @@ std::string matrixNode(const std::string& key, int rows, int cols, const std::st
 
 /// Camera 2 m along LiDAR x, looking along LiDAR x (camera z = LiDAR x, camera x = -LiDAR y,
 /// camera y = -LiDAR z).
-std::string syntheticFile(const std::string& skip = "", const std::string& extrinsic_row0 =
-                                                            "0, 0, 1, 2") {
+std::string syntheticFile(const std::string& skip = "",
+                          const std::string& extrinsic_row0 = "0, 0, 1, 2") {
   std::string text = "%YAML:1.0\n---\n";
   if (skip != "CameraExtrinsicMat") {
     text += matrixNode("CameraExtrinsicMat", 4, 4,
                        extrinsic_row0 + ", -1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 0, 1");
   }
-  if (skip != "CameraMat") text += matrixNode("CameraMat", 3, 3, "1000, 0, 640, 0, 900, 360, 0, 0, 1");
+  if (skip != "CameraMat")
+    text += matrixNode("CameraMat", 3, 3, "1000, 0, 640, 0, 900, 360, 0, 0, 1");
   if (skip != "DistCoeff") text += matrixNode("DistCoeff", 1, 5, "0.1, -0.05, 0.001, 0.002, 0.01");
   if (skip != "ImageSize") text += "ImageSize: [ 1280, 720 ]\n";
   text += "UnknownExtra: 5\n";

@@ -61,10 +61,10 @@ SceneResult runScene(const std::string& name) {
       fused.compute({scene.left, left.prior, left.bounds}, {scene.right, right.prior, right.bounds})
           .disparity;
   PatchMatchStereo plain(FusionParams::plainPmsParams(params.patchmatch));
-  const cv::Mat1f pms_disparity =
-      plain.compute({scene.left, cv::Mat1f(), ScanLineBounds()},
-                    {scene.right, cv::Mat1f(), ScanLineBounds()})
-          .disparity;
+  const cv::Mat1f pms_disparity = plain
+                                      .compute({scene.left, cv::Mat1f(), ScanLineBounds()},
+                                               {scene.right, cv::Mat1f(), ScanLineBounds()})
+                                      .disparity;
 
   SceneResult result;
   result.lidar_bi = evaluateDisparity(left.prior, scene.disparity);

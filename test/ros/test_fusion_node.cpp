@@ -201,6 +201,16 @@ class Harness {
       }
     }
   }
+  /// Every output subscriber is connected to the nodelet (outputs without a connection are not
+  /// computed, so a set published before would miss them).
+  bool outputsConnected(double timeout = 10.0) {
+    return waitFor(timeout, [&] {
+      for (const auto& s : subs_) {
+        if (s.getNumPublishers() == 0) return false;
+      }
+      return true;
+    });
+  }
   void unsubscribeOutputs() {
     for (auto& s : subs_) s.shutdown();
     subs_.clear();
@@ -415,6 +425,7 @@ TEST_F(FusionNode, A_LazySubscription) {
 
 TEST_F(FusionNode, B_OneOutputPerInputSetOnEveryTopic) {
   h().subscribeOutputs();
+  ASSERT_TRUE(h().outputsConnected());
   ASSERT_TRUE(h().inputsSubscribed(true, 10.0));
   const std::vector<std::string> encodings = {"bgr8", "bgra8", "rgb8", "rgba8", "mono8"};
   uint32_t last_processed = 0;
@@ -758,6 +769,7 @@ TEST_F(FusionNode, L_DiagnosticsReportRateAndProcessingTime) {
 // Only in fusion_approx_sync.test: right image and info stamped 4 ms after the left ones.
 TEST_F(FusionNode, Approx_SetsWithDifferentStampsAreMatched) {
   h().subscribeOutputs();
+  ASSERT_TRUE(h().outputsConnected());
   ASSERT_TRUE(h().inputsSubscribed(true, 10.0));
   std::vector<ros::Time> stamps;
   for (int i = 0; i < 10; ++i) {

@@ -26,6 +26,7 @@
 
 #include <cv_bridge/cv_bridge.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -384,8 +385,10 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
   // The offline runner on the same three frames.
   const std::string runner_out = scratchDir() + "/runner";
   fs::remove_all(runner_out);
-  const auto [runner_status, runner_output] = run(std::string(LSF_KITTI_RUNNER) + " --kitti-raw " +
-                                                  drive + " --out " + runner_out);
+  // Same parameter file as the nodelet's (fusion.launch loads config/fusion.yaml).
+  const auto [runner_status, runner_output] =
+      run(std::string(LSF_KITTI_RUNNER) + " --kitti-raw " + drive + " --out " + runner_out +
+          " --params " + LSF_SOURCE_DIR + "/config/fusion.yaml");
   ASSERT_EQ(runner_status, 0) << runner_output;
 
   std::lock_guard<std::mutex> lock(outputs.mutex_);

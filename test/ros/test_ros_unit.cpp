@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <limits>
 #include <map>
 #include <set>
@@ -515,7 +517,11 @@ TEST(RosParams, ShippedYamlHasEveryParameterAndLoadsInTheCore) {
   ASSERT_NO_THROW(lsf::loadParamsYaml(path, loaded));
   EXPECT_EQ(lsf::ros_params::describeChanges(lsf::FusionParams(), loaded), "")
       << "config/fusion.yaml documents the paper's values, which are the struct defaults";
-  cv::FileStorage fs(path, cv::FileStorage::READ);
+  // rosparam files have no "%YAML:1.0" directive, which OpenCV's reader needs.
+  std::ifstream in(path);
+  std::stringstream text;
+  text << "%YAML:1.0\n---\n" << in.rdbuf();
+  cv::FileStorage fs(text.str(), cv::FileStorage::READ | cv::FileStorage::MEMORY);
   ASSERT_TRUE(fs.isOpened());
   for (const auto& info : lsf::ros_params::listParams()) {
     const auto slash = info.ros_name.find('/');

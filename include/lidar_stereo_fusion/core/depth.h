@@ -19,14 +19,14 @@ cv::Mat1f disparityToDepth(const cv::Mat1f& disparity, const StereoCamera& camer
 cv::Mat1f depthToDisparity(const cv::Mat1f& depth, const StereoCamera& camera);
 
 struct ColoredPoint {
-  float x, y, z;          ///< [m], left optical frame
+  float x, y, z;  ///< [m], left optical frame
   uint8_t r, g, b;
 };
 
 /// X = (x - cx) z / fx, Y = (y - cy) z / fy, colour from `image` (BGR or grey).
 /// Pixels without depth (<= 0 / not finite) are skipped; `stride` (>= 1) subsamples rows and
-/// columns, starting at (0, 0). Points are in row-major order. Throws std::invalid_argument when the
-/// image and depth sizes differ, the image type is not CV_8UC3/CV_8UC1, or stride < 1.
+/// columns, starting at (0, 0). Points are in row-major order. Throws std::invalid_argument when
+/// the image and depth sizes differ, the image type is not CV_8UC3/CV_8UC1, or stride < 1.
 std::vector<ColoredPoint> makeColoredCloud(const cv::Mat1f& depth, const cv::Mat& image,
                                            const StereoCamera& camera, int stride = 1);
 

@@ -11,20 +11,20 @@ namespace lidar_stereo_fusion {
 
 /// Scores of one image over the pixels where the reference has a value.
 struct DepthMetrics {
-  double mae_mm = 0, rmse_mm = 0;        ///< depth errors [mm]
+  double mae_mm = 0, rmse_mm = 0;            ///< depth errors [mm]
   double imae_per_km = 0, irmse_per_km = 0;  ///< inverse-depth errors [1/km]
-  double bad2 = 0, bad3 = 0, bad5 = 0;   ///< fraction of pixels with disparity error > 2/3/5 px
-  double coverage = 0;                   ///< fraction of reference pixels the estimate covers
-  int count = 0;                         ///< reference pixels scored
+  double bad2 = 0, bad3 = 0, bad5 = 0;       ///< fraction of pixels with disparity error > 2/3/5 px
+  double coverage = 0;                       ///< fraction of reference pixels the estimate covers
+  int count = 0;                             ///< reference pixels scored
 };
 
-/// Scores `depth` [m] against `reference` [m] (0 / NaN = no value) over every reference pixel. Where
-/// the estimate has no value (<= 0 or not finite), it counts as depth 0 for MAE/RMSE (as the KITTI
-/// devkit does), as inverse depth 0 for iMAE/iRMSE (error 1/z_ref) and as disparity 0 for the bad-
-/// pixel rates (error fx B / z_ref), unless `only_covered` is true (then those pixels are skipped;
-/// `coverage` is always the covered fraction of all reference pixels). Disparity errors use
-/// fx * B / z with the given camera. Throws std::invalid_argument on a size mismatch or an invalid
-/// camera. An image without reference pixels gives count 0 and zero scores.
+/// Scores `depth` [m] against `reference` [m] (0 / NaN = no value) over every reference pixel.
+/// Where the estimate has no value (<= 0 or not finite), it counts as depth 0 for MAE/RMSE (as the
+/// KITTI devkit does), as inverse depth 0 for iMAE/iRMSE (error 1/z_ref) and as disparity 0 for the
+/// bad-pixel rates (error fx B / z_ref), unless `only_covered` is true (then those pixels are
+/// skipped; `coverage` is always the covered fraction of all reference pixels). Disparity errors
+/// use fx * B / z with the given camera. Throws std::invalid_argument on a size mismatch or an
+/// invalid camera. An image without reference pixels gives count 0 and zero scores.
 DepthMetrics evaluateDepth(const cv::Mat1f& depth, const cv::Mat1f& reference,
                            const StereoCamera& camera, bool only_covered = false);
 

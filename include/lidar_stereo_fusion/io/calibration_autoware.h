@@ -20,8 +20,10 @@ struct AutowareCalibration {
   cv::Size image_size;             ///< ImageSize
   double reprojection_error = -1;  ///< ReprojectionError (-1 when absent) [px]
   std::string dist_model;          ///< DistModel ("plumb_bob" when absent)
-  struct Pair { double u, v, x, y, z; };
-  std::vector<Pair> calib_data;    ///< CalibData clicked pairs (pixel u, v; LiDAR point x, y, z)
+  struct Pair {
+    double u, v, x, y, z;
+  };
+  std::vector<Pair> calib_data;  ///< CalibData clicked pairs (pixel u, v; LiDAR point x, y, z)
 };
 
 /// Reads the file; unknown keys are ignored. Throws std::runtime_error naming the missing key.

@@ -25,9 +25,9 @@ struct RingSplit {
 RingSplit splitRingsEvenOdd(const LidarCloud& cloud);
 
 /// Reference depth [m] of the held-out points in the left image: every finite point with
-/// params.min_depth <= z <= params.max_depth is projected (u = fx X/z + cx, v = fy Y/z + cy, rounded
-/// to the nearest pixel as projectCloud does), the nearest point wins a pixel (z-buffer), and the
-/// pixel stores its z. 0 = no reference. Throws std::invalid_argument on an invalid camera.
+/// params.min_depth <= z <= params.max_depth is projected (u = fx X/z + cx, v = fy Y/z + cy,
+/// rounded to the nearest pixel as projectCloud does), the nearest point wins a pixel (z-buffer),
+/// and the pixel stores its z. 0 = no reference. Throws std::invalid_argument on an invalid camera.
 cv::Mat1f projectReferenceDepth(const LidarCloud& held_out, const Eigen::Isometry3d& T_cam_lidar,
                                 const StereoCamera& camera, const ProjectionParams& params);
 

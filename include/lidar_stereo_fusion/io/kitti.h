@@ -45,7 +45,7 @@ void writeDepthPng(const std::string& path, const cv::Mat1f& depth_m);
 
 /// One frame of a drive (paths; files are read on demand).
 struct Frame {
-  std::string name;        ///< e.g. "0000000005"
+  std::string name;  ///< e.g. "0000000005"
   std::string left_image, right_image, velodyne;
 };
 /// Lists frames of `drive_dir` that have image_02, image_03 and a velodyne .bin, sorted by name.

@@ -12,8 +12,8 @@ namespace lidar_stereo_fusion {
 
 /// One scene: im2 (left), im6 (right), disp2 (left ground truth).
 struct MiddleburyScene {
-  cv::Mat left, right;   ///< BGR CV_8UC3
-  cv::Mat1f disparity;   ///< left ground-truth disparity [px] = PNG value / scale, 0 = unknown
+  cv::Mat left, right;  ///< BGR CV_8UC3
+  cv::Mat1f disparity;  ///< left ground-truth disparity [px] = PNG value / scale, 0 = unknown
 };
 
 /// Reads `dir`/im2.png, im6.png and disp2.png (quarter size: disparity_scale = 4). Throws

@@ -16,7 +16,8 @@ cv::Mat colorizeDepth(const cv::Mat1f& depth, double max_depth = 80.0);
 
 /// Absolute error |estimate - reference| in px, clipped at max_error, only where the reference has
 /// a value (elsewhere black); a reference pixel without estimate shows as max_error. Returns BGR8.
-cv::Mat colorizeError(const cv::Mat1f& estimate, const cv::Mat1f& reference, double max_error = 5.0);
+cv::Mat colorizeError(const cv::Mat1f& estimate, const cv::Mat1f& reference,
+                      double max_error = 5.0);
 
 /// Draws sparse LiDAR disparity as coloured dots over a darkened copy of `image`. Returns BGR8.
 cv::Mat overlaySparse(const cv::Mat& image, const cv::Mat1f& sparse, double max_disparity = 0.0);

@@ -41,8 +41,8 @@ const std::vector<std::string>& supportedImageEncodings();
 std::string checkImage(const sensor_msgs::Image& msg);
 
 /// Converts one rectified image to what the core takes: BGR CV_8UC3 for colour encodings, CV_8UC1
-/// for mono8. The result may share memory with `msg` (bgr8, mono8): keep `msg` alive while using
-/// it. Throws ConversionError on an unsupported encoding or a malformed message.
+/// for mono8 (always a copy that owns its pixels). Throws ConversionError on an unsupported
+/// encoding or a malformed message.
 cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg);
 
 /// Converts a stereo pair; the two results have the same type (mono + colour: both BGR).

@@ -28,6 +28,7 @@
 #include <thread>
 
 #include <boost/optional.hpp>
+#include <boost/thread/recursive_mutex.hpp>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
 #include <dynamic_reconfigure/server.h>
@@ -171,6 +172,7 @@ class FusionWorker {
   std::mutex params_mutex_;
   FusionParams params_;
   bool params_changed_ = false;
+  boost::recursive_mutex reconfigure_mutex_;  ///< the server's (so updateConfig() cannot deadlock)
   std::unique_ptr<dynamic_reconfigure::Server<FusionConfig>> reconfigure_server_;
 
   Counters counters_;

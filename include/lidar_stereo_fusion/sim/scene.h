@@ -18,8 +18,8 @@ namespace sim {
 
 /// First intersection of a ray with the scene.
 struct Hit {
-  double t = 0.0;               ///< distance along the (unit) ray direction [m]
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();   ///< street frame [m]
+  double t = 0.0;                                   ///< distance along the (unit) ray direction [m]
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< street frame [m]
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit, facing the ray's origin
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();      ///< surface coordinates [m]
   int material = -1;
@@ -37,8 +37,8 @@ struct Lighting {
 
 /// Primitive shapes (street frame).
 struct PlaneShape {
-  Eigen::Vector3d normal;  ///< unit; the plane is {X : normal . X = offset}
-  double offset;           ///< [m]
+  Eigen::Vector3d normal;          ///< unit; the plane is {X : normal . X = offset}
+  double offset;                   ///< [m]
   Eigen::Vector3d u_axis, v_axis;  ///< unit surface axes (uv = (X . u_axis, X . v_axis))
 };
 struct BoxShape {
@@ -92,9 +92,16 @@ class Scene {
                       double tolerance_m) const;
 
   /// Linear RGB in [0, 1] seen along the ray: the shaded textured surface, or the sky.
-  /// `pixel_angle_rad` (angular size of a pixel) sets the texture pre-filter.
+  /// The texture pre-filter is sized by the pixel footprint of a pinhole camera at `filter_centre`
+  /// looking along +z with focal length `focal_px` [px]. Pass the same camera (the left one) for
+  /// both views: then a surface point has exactly the same colour in both.
   Eigen::Vector3d radiance(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                           double pixel_angle_rad) const;
+                           const Eigen::Vector3d& filter_centre, double focal_px) const;
+
+  /// Size [m] of one pixel of that camera on the surface at `hit` (the square root of the
+  /// footprint's area: z / f * sqrt(cos(off-axis angle) / cos(incidence))).
+  static double pixelFootprint(const Hit& hit, const Eigen::Vector3d& filter_centre,
+                               double focal_px);
 
   /// Colour of the sky in `direction` (linear RGB).
   Eigen::Vector3d skyColour(const Eigen::Vector3d& direction) const;
@@ -113,7 +120,7 @@ class Scene {
   struct Group {
     Eigen::AlignedBox3d bounds;  ///< empty() for unbounded groups (planes)
     bool bounded = true;
-    int first = 0, end = 0;      ///< primitives [first, end)
+    int first = 0, end = 0;  ///< primitives [first, end)
   };
 
   int addPrimitive(const Shape& shape, int material, const Eigen::AlignedBox3d& bounds,

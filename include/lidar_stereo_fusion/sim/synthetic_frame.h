@@ -21,30 +21,30 @@ struct SyntheticParams {
   uint64_t seed = 1;  ///< scene layout jitter, textures and all noise
 
   // Rectified stereo pair (KITTI 2011_09_26 rectified intrinsics).
-  int width = 1242;              ///< [px]
-  int height = 375;              ///< [px]
-  double fx = 721.5377;          ///< [px]
-  double fy = 721.5377;          ///< [px]
-  double cx = 609.5593;          ///< [px]
-  double cy = 172.854;           ///< [px]
-  double baseline = 0.54;        ///< right camera is at +baseline along the left camera's x [m]
-  int subsamples = 2;            ///< anti-aliasing: subsamples^2 rays per pixel
+  int width = 1242;                ///< [px]
+  int height = 375;                ///< [px]
+  double fx = 721.5377;            ///< [px]
+  double fy = 721.5377;            ///< [px]
+  double cx = 609.5593;            ///< [px]
+  double cy = 172.854;             ///< [px]
+  double baseline = 0.54;          ///< right camera is at +baseline along the left camera's x [m]
+  int subsamples = 2;              ///< anti-aliasing: subsamples^2 rays per pixel
   double image_noise_sigma = 1.0;  ///< Gaussian noise per channel [grey levels of 255]
-  double gamma = 1.8;            ///< display gamma applied to the linear radiance
+  double gamma = 1.8;              ///< display gamma applied to the linear radiance
 
   // LiDAR.
-  int rings = 64;                ///< 64 (HDL-64E-like) or 128 (VLS-128-like)
-  double azimuth_step_deg = 0.0; ///< 0 = the sensor's own (0.09 for 64 rings, 0.2 for 128)
-  double range_noise_sigma = 0.0;     ///< [m]
-  double dropout_probability = 0.0;   ///< in [0, 1)
+  int rings = 64;                    ///< 64 (HDL-64E-like) or 128 (VLS-128-like)
+  double azimuth_step_deg = 0.0;     ///< 0 = the sensor's own (0.09 for 64 rings, 0.2 for 128)
+  double range_noise_sigma = 0.0;    ///< [m]
+  double dropout_probability = 0.0;  ///< in [0, 1)
   /// LiDAR origin in the left optical frame [m] (KITTI-like: 0.27 m behind, 0.08 m above). The
   /// LiDAR axes are Velodyne's (x forward, y left, z up), aligned with the camera's.
   Eigen::Vector3d lidar_position{0.0, -0.08, -0.27};
 
   // Motion: the rig drives along the street's +z.
-  double speed = 10.0;           ///< [m/s]
-  double frame_period = 0.1;     ///< [s] between frames (one LiDAR revolution)
-  double camera_height = 1.65;   ///< above the street's ground [m]
+  double speed = 10.0;          ///< [m/s]
+  double frame_period = 0.1;    ///< [s] between frames (one LiDAR revolution)
+  double camera_height = 1.65;  ///< above the street's ground [m]
 
   /// Throws std::invalid_argument naming the first impossible value.
   void validate() const;
@@ -60,10 +60,10 @@ struct SyntheticParams {
 
 /// Ground truth of one LiDAR point (for the noise-free surface point its beam hit).
 struct PointTruth {
-  float depth = 0.f;     ///< z in the left optical frame [m] (<= 0: behind the camera)
-  int u = -1, v = -1;    ///< nearest pixel in the left image (i = floor(x + 0.5)), -1 if outside
-  bool in_image = false; ///< depth > 0 and (u, v) inside the left image
-  bool visible = false;  ///< in_image and the segment from the left optical centre is unobstructed
+  float depth = 0.f;      ///< z in the left optical frame [m] (<= 0: behind the camera)
+  int u = -1, v = -1;     ///< nearest pixel in the left image (i = floor(x + 0.5)), -1 if outside
+  bool in_image = false;  ///< depth > 0 and (u, v) inside the left image
+  bool visible = false;   ///< in_image and the segment from the left optical centre is unobstructed
 };
 
 /// One synthetic frame.
@@ -74,13 +74,13 @@ struct SyntheticFrame {
   StereoCamera camera;
   Eigen::Isometry3d T_cam_lidar = Eigen::Isometry3d::Identity();  ///< LiDAR -> left optical
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();  ///< left optical -> street
-  cv::Mat1f depth;                ///< exact left depth at pixel centres [m], 0 = sky
-  cv::Mat1f disparity;            ///< fx * B / depth [px], 0 = sky
-  cv::Mat1b low_texture;          ///< 255 where the pixel centre sees the untextured material
+  cv::Mat1f depth;        ///< exact left depth at pixel centres [m], 0 = sky
+  cv::Mat1f disparity;    ///< fx * B / depth [px], 0 = sky
+  cv::Mat1b low_texture;  ///< 255 where the pixel centre sees the untextured material
   /// 255 where the surface point at the pixel centre lies within the LiDAR's elevation range as
   /// seen from the LiDAR (ignoring occlusion): where KITTI's accumulated-LiDAR ground truth exists.
   cv::Mat1b lidar_fov;
-  double stamp = 0.0;             ///< [s] since the first frame
+  double stamp = 0.0;  ///< [s] since the first frame
 };
 
 /// Renders frame `index` of `scene`: the left camera at (0, 0, speed * frame_period * index) of

@@ -26,11 +26,11 @@ enum class Pattern {
 struct Material {
   Eigen::Vector3d albedo{0.5, 0.5, 0.5};  ///< linear RGB reflectance, each in [0, 1]
   Pattern pattern = Pattern::kNoise;
-  double contrast = 0.3;        ///< relative brightness amplitude of the texture (0 = none)
-  double wavelength_m = 0.5;    ///< coarsest noise wavelength [m]; octaves halve it
-  int octaves = 5;              ///< noise octaves
+  double contrast = 0.3;            ///< relative brightness amplitude of the texture (0 = none)
+  double wavelength_m = 0.5;        ///< coarsest noise wavelength [m]; octaves halve it
+  int octaves = 5;                  ///< noise octaves
   double lidar_reflectivity = 0.3;  ///< LiDAR intensity at normal incidence, in [0, 1]
-  bool low_texture = false;     ///< marks the region where stereo alone is expected to fail
+  bool low_texture = false;         ///< marks the region where stereo alone is expected to fail
 };
 
 /// Smooth value noise in [0, 1] on the unit lattice (quintic interpolation of hashed corners).

@@ -1,0 +1,249 @@
+// kitti_runner end to end on a small synthetic KITTI drive written to a temp folder: output format,
+// scoring, and a non-zero exit with a clear message for every kind of missing or corrupt input.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "lidar_stereo_fusion/io/kitti.h"
+
+namespace lidar_stereo_fusion {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The runner next to the test (plain CMake) or in the catkin devel space.
+std::string runnerPath() {
+  const fs::path build(LSF_BINARY_DIR);
+  for (const fs::path& candidate :
+       {build / "kitti_runner",
+        build / ".." / ".." / "devel" / "lib" / "lidar_stereo_fusion" / "kitti_runner"}) {
+    if (fs::is_regular_file(candidate)) return candidate.string();
+  }
+  return "";
+}
+
+struct RunResult {
+  int status = -1;
+  std::string out, err;
+};
+
+std::string readAll(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// A synthetic drive "<root>/2011_01_01/drive_sync": 80x60 images, 3 frames, 16-laser sweeps in
+/// KITTI storage order (laser by laser, azimuth from just past 0 through +-180 to just before 0) of
+/// a sphere of radius 10 m around the sensor.
+class SyntheticDrive {
+ public:
+  SyntheticDrive() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    root_ = fs::temp_directory_path() /
+            ("lsf_runner_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    drive_ = root_ / "2011_01_01" / "drive_sync";
+    for (const char* sub : {"image_02/data", "image_03/data", "velodyne_points/data"}) {
+      fs::create_directories(drive_ / sub);
+    }
+    writeCalibration("");
+    for (const std::string name : {"0000000000", "0000000001", "0000000002"}) {
+      writeFrame(name, sweep(false));
+    }
+  }
+  ~SyntheticDrive() { fs::remove_all(root_); }
+
+  /// Writes the calibration, leaving out `drop_key`.
+  void writeCalibration(const std::string& drop_key) const {
+    std::ofstream cam(root_ / "2011_01_01" / "calib_cam_to_cam.txt");
+    auto line = [&](std::ostream& out, const std::string& key, const std::string& values) {
+      if (key != drop_key) out << key << ": " << values << "\n";
+    };
+    line(cam, "R_rect_00", "1 0 0 0 1 0 0 0 1");
+    line(cam, "P_rect_02", "60 0 40 3 0 60 30 0 0 0 1 0");
+    line(cam, "P_rect_03", "60 0 40 -27 0 60 30 0 0 0 1 0");  // B = 0.5 m
+    line(cam, "S_rect_02", "80 60");
+    std::ofstream velo(root_ / "2011_01_01" / "calib_velo_to_cam.txt");
+    line(velo, "R", "0 -1 0 0 0 -1 1 0 0");  // x forward, y left, z up -> optical
+    line(velo, "T", "0 0 0");
+  }
+
+  void writeFrame(const std::string& name, const LidarCloud& cloud) const {
+    cv::Mat image(60, 80, CV_8UC3);
+    std::mt19937 rng(std::stoi(name) + 1);
+    std::uniform_int_distribution<int> value(0, 255);
+    for (auto it = image.begin<cv::Vec3b>(); it != image.end<cv::Vec3b>(); ++it) {
+      *it = cv::Vec3b(value(rng), value(rng), value(rng));
+    }
+    cv::imwrite((drive_ / "image_02/data" / (name + ".png")).string(), image);
+    cv::imwrite((drive_ / "image_03/data" / (name + ".png")).string(), image);
+    kitti::writeVelodyneBin((drive_ / "velodyne_points/data" / (name + ".bin")).string(), cloud);
+  }
+
+  /// 16 lasers from +2 to -28 deg elevation; `behind` keeps only points with x < 0.
+  static LidarCloud sweep(bool behind) {
+    LidarCloud cloud;
+    for (int laser = 0; laser < 16; ++laser) {
+      const double elevation = (2.0 - 2.0 * laser) * M_PI / 180.0;
+      for (int k = 0; k < 900; ++k) {
+        const double azimuth = (0.2 + 0.4 * k) * M_PI / 180.0;  // 0.2 .. 359.8 deg
+        LidarPoint p;
+        p.x = static_cast<float>(10 * std::cos(elevation) * std::cos(azimuth));
+        p.y = static_cast<float>(10 * std::cos(elevation) * std::sin(azimuth));
+        p.z = static_cast<float>(10 * std::sin(elevation));
+        if (behind && p.x >= 0) continue;
+        cloud.push_back(p);
+      }
+    }
+    return cloud;
+  }
+
+  RunResult run(const std::string& args) const {
+    const fs::path out = root_ / "stdout.txt", err = root_ / "stderr.txt";
+    const std::string command = runnerPath() + " --kitti-raw " + drive_.string() + " " + args +
+                                " > " + out.string() + " 2> " + err.string();
+    RunResult r;
+    const int raw = std::system(command.c_str());
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = readAll(out);
+    r.err = readAll(err);
+    return r;
+  }
+
+  fs::path drive() const { return drive_; }
+  fs::path outDir() const { return root_ / "out"; }
+
+ private:
+  fs::path root_, drive_;
+};
+
+#define REQUIRE_RUNNER()                                                    \
+  if (runnerPath().empty()) {                                               \
+    GTEST_SKIP() << "kitti_runner is not built next to " << LSF_BINARY_DIR; \
+  }
+
+TEST(KittiRunner, WritesKittiDepthPngsOfImageSizeAndScoresAReference) {
+  REQUIRE_RUNNER();
+  SyntheticDrive drive;
+  const std::string out = drive.outDir().string();
+  const RunResult r = drive.run("--out " + out + " --method lidar_bi --save-vis");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const std::string name : {"0000000000", "0000000001", "0000000002"}) {
+    const cv::Mat raw = cv::imread(out + "/" + name + ".png", cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(raw.type(), CV_16UC1) << name;
+    EXPECT_EQ(raw.size(), cv::Size(80, 60));
+    // The sphere is 10 m from the sensor: depth along the optical axis is at most 10 m.
+    const cv::Mat1f depth = kitti::readDepthPng(out + "/" + name + ".png");
+    double max_depth = 0;
+    cv::minMaxLoc(depth, nullptr, &max_depth);
+    EXPECT_GT(cv::countNonZero(depth), 500);
+    EXPECT_LE(max_depth, 10.0 + 1.0 / 256);
+    EXPECT_TRUE(fs::exists(out + "/vis/" + name + "_disparity.png"));
+  }
+  EXPECT_NE(r.out.find("| projection |"), std::string::npos) << r.out;  // timing summary
+  EXPECT_NE(r.err.find("3/3"), std::string::npos) << r.err;             // progress bar
+
+  // Score the output against itself: zero error on every covered pixel.
+  const RunResult scored =
+      drive.run("--out " + out + "_2 --method lidar_bi --reference " + out + " --frames 2");
+  ASSERT_EQ(scored.status, 0) << scored.err;
+  // The reference PNG is quantised to 1/256 m: errors below 2 mm, no bad pixel, full coverage.
+  const auto mean = scored.out.find("| mean (2 frames) |");
+  ASSERT_NE(mean, std::string::npos) << scored.out;
+  double mae = -1, rmse = -1;
+  ASSERT_EQ(std::sscanf(scored.out.c_str() + mean, "| mean (2 frames) | %lf | %lf |", &mae, &rmse),
+            2);
+  EXPECT_LE(mae, 2.0);
+  EXPECT_LE(rmse, 2.0);
+  const std::string line = scored.out.substr(mean, scored.out.find('\n', mean) - mean);
+  EXPECT_NE(line.find("| 0.00 | 0.00 | 0.00 | 100.0 |"), std::string::npos) << line;
+  fs::remove_all(out + "_2");
+}
+
+TEST(KittiRunner, FusedDefaultAndHoldoutRun) {
+  REQUIRE_RUNNER();
+  SyntheticDrive drive;
+  const RunResult r = drive.run("--out " + drive.outDir().string() + " --holdout even --frames 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("fused_bi"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("mean (1 frames)"), std::string::npos) << r.out;
+}
+
+TEST(KittiRunner, BadCommandLinesExitWith2AndHelpWith0) {
+  REQUIRE_RUNNER();
+  SyntheticDrive drive;
+  EXPECT_EQ(drive.run("--out x --bogus").status, 2);
+  EXPECT_EQ(drive.run("").status, 2);  // no --out
+  EXPECT_EQ(drive.run("--out x --method magic").status, 2);
+  EXPECT_EQ(drive.run("--out x --frames 0").status, 2);
+  EXPECT_EQ(drive.run("--out x --holdout even --reference y").status, 2);
+  const RunResult help = drive.run("--help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.out.find("Usage"), std::string::npos);
+}
+
+/// Runs into a fresh output folder; expects status 1 and `message` in stderr.
+void expectFailure(const SyntheticDrive& drive, const std::string& message,
+                   const std::string& extra = "--method lidar_bi") {
+  const RunResult r = drive.run("--out " + drive.outDir().string() + " " + extra);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+}
+
+TEST(KittiRunner, MissingOrCorruptInputExitsWith1AndSaysWhat) {
+  REQUIRE_RUNNER();
+  {
+    SyntheticDrive drive;
+    drive.writeCalibration("P_rect_03");
+    expectFailure(drive, "'P_rect_03'");
+  }
+  {
+    SyntheticDrive drive;
+    std::ofstream(drive.drive() / "velodyne_points/data/0000000001.bin", std::ios::binary)
+        << "seventeen bytes!!";
+    expectFailure(drive, "multiple of 16");
+  }
+  {
+    SyntheticDrive drive;
+    cv::imwrite((drive.drive() / "image_03/data/0000000000.png").string(),
+                cv::Mat(50, 80, CV_8UC3, cv::Scalar::all(0)));
+    expectFailure(drive, "sizes differ");
+  }
+  {
+    SyntheticDrive drive;
+    std::ofstream(drive.drive() / "image_02/data/0000000002.png") << "not a png";
+    expectFailure(drive, "cannot read image");
+  }
+  {
+    SyntheticDrive drive;
+    drive.writeFrame("0000000001", SyntheticDrive::sweep(true));
+    expectFailure(drive, "0000000001");
+    expectFailure(drive, "0000000001", "--method pms");
+  }
+  {
+    SyntheticDrive drive;
+    fs::create_directories(drive.outDir() / "ref");
+    std::ofstream(drive.outDir() / "ref" / "0000000000.png") << "not a png";
+    expectFailure(drive, "depth PNG",
+                  "--method lidar_bi --reference " + (drive.outDir() / "ref").string());
+  }
+  {
+    SyntheticDrive drive;
+    fs::remove_all(drive.drive() / "image_03");
+    expectFailure(drive, "no frame");
+  }
+}
+
+}  // namespace
+}  // namespace lidar_stereo_fusion
