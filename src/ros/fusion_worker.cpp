@@ -185,7 +185,8 @@ void FusionWorker::advertise() {
   pub_disparity_ = nh_.advertise<stereo_msgs::DisparityImage>("disparity", 1, ros_cb, ros_cb);
   pub_points_ = nh_.advertise<sensor_msgs::PointCloud2>("points2", 1, ros_cb, ros_cb);
   pub_stats_ = advertiseStats(nh_, "stats", 10, ros_cb);
-  pub_depth_ = it_->advertiseCamera("depth", 1, it_cb, it_cb, ros_cb, ros_cb);
+  pub_depth_ = it_->advertise("depth", 1, it_cb, it_cb);
+  pub_depth_info_ = nh_.advertise<sensor_msgs::CameraInfo>("depth/camera_info", 1, ros_cb, ros_cb);
   pub_lidar_disparity_ = it_->advertise("lidar_disparity", 1, it_cb, it_cb);
   pub_disparity_image_ = it_->advertise("disparity_image", 1, it_cb, it_cb);
 }
@@ -195,6 +196,7 @@ void FusionWorker::connectCb() {
   const uint32_t subscribers = pub_disparity_.getNumSubscribers() +
                                pub_points_.getNumSubscribers() + pub_stats_.getNumSubscribers() +
                                pub_depth_.getNumSubscribers() +
+                               pub_depth_info_.getNumSubscribers() +
                                pub_lidar_disparity_.getNumSubscribers() +
                                pub_disparity_image_.getNumSubscribers();
   if (subscribers == 0 && subscribed_) {
@@ -270,7 +272,7 @@ bool FusionWorker::checkImageSet(const ImageSet& set) {
   const auto reject = [this](const std::string& topic, const std::string& problem,
                              const ros::Time& stamp) {
     ++counters_.invalid;
-    warnThrottled(topic + problem.substr(0, 12),
+    warnThrottled(topic + problem,
                   topicName(topic) + ": " + problem + " (stamp " + stampText(stamp) +
                       "); image set skipped");
     return false;
@@ -352,7 +354,7 @@ void FusionWorker::cloudCb(const CloudConstPtr& cloud) {
   if (problem.empty() && cloud->header.frame_id.empty()) problem = "empty frame_id";
   if (!problem.empty()) {
     ++counters_.invalid;
-    warnThrottled(std::string(kCloud) + problem.substr(0, 12),
+    warnThrottled(std::string(kCloud) + problem,
                   topicName(kCloud) + ": " + problem + " (stamp " + stampText(stamp) +
                       "); sweep skipped");
     return;
@@ -551,6 +553,8 @@ void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera
   }
   if (pub_depth_.getNumSubscribers() > 0) {
     depth_msg = conversions::depthToMsg(depth, header, node_params_.max_output_depth);
+  }
+  if (pub_depth_info_.getNumSubscribers() > 0) {
     depth_info = boost::make_shared<sensor_msgs::CameraInfo>(*match.images.left_info);
     depth_info->header = header;
   }
@@ -573,7 +577,8 @@ void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera
   // Publish everything as close together as possible; latency = now - image stamp.
   const ros::Time publish_time = ros::Time::now();
   if (disparity_msg) pub_disparity_.publish(disparity_msg);
-  if (depth_msg) pub_depth_.publish(depth_msg, depth_info);
+  if (depth_msg) pub_depth_.publish(depth_msg);
+  if (depth_info) pub_depth_info_.publish(depth_info);
   if (disparity_image_msg) pub_disparity_image_.publish(disparity_image_msg);
   if (prior_msg) pub_lidar_disparity_.publish(prior_msg);
   if (points_msg) pub_points_.publish(points_msg);

@@ -153,7 +153,10 @@ class FusionWorker {
 
   // Outputs.
   ros::Publisher pub_disparity_, pub_points_, pub_stats_;
-  image_transport::CameraPublisher pub_depth_;
+  // depth + depth/camera_info: not an image_transport CameraPublisher, which would put the info
+  // next to the image (camera_info), not under it.
+  image_transport::Publisher pub_depth_;
+  ros::Publisher pub_depth_info_;
   image_transport::Publisher pub_lidar_disparity_, pub_disparity_image_;
 
   // TF (own listener thread).
