@@ -42,6 +42,13 @@ add_rostest(test/ros/fusion_nodelet.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_node.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_approx_sync.test DEPENDENCIES test_fusion_node)
 
+# RViz with rviz/fusion.rviz under Xvfb: the fused cloud is drawn (screenshots in the build folder).
+lsf_add_ros_test_node(test_rviz_screenshot test/ros/test_rviz_screenshot.cpp)
+add_rostest(test/ros/rviz_screenshot.test DEPENDENCIES test_rviz_screenshot)
+
+# The simulated street as a live rig: demos, the RViz check, latency and rate measurements.
+lsf_add_ros_test_node(synthetic_publisher test/ros/synthetic_publisher.cpp)
+
 # Launch files (tools' launch files too: their executables must exist).
 find_package(roslaunch REQUIRED)
 set(LSF_LAUNCH_CHECK_DEPENDS fusion_node ${PROJECT_NAME}_ros)

@@ -30,7 +30,7 @@ catkin_make "${CMAKE_ARGS[@]}" -j"$JOBS" all
 # `run_tests` builds only the test targets, so `all` comes first.
 rm -rf "$WS/build/test_results"
 echo "== tests"
-set +e
+set +eu  # catkin's setup scripts read unset variables
 # shellcheck disable=SC1091
 source "$WS/devel/setup.bash"
 catkin_make "${CMAKE_ARGS[@]}" -j"$JOBS" run_tests
