@@ -420,6 +420,8 @@ void PatchMatchParams::validate() const {
   require(std::abs(alpha + beta + gamma - 1.0) < 1e-6, "alpha + beta + gamma must be 1");
   require(lambda_col > 0 && lambda_grad > 0 && lambda_disp > 0, "truncations must be > 0");
   require(iterations >= 0 && iterations <= 100, "iterations must be in [0, 100]");
+  require(right_iterations >= -1 && right_iterations <= iterations,
+          "right_iterations must be in [-1, iterations] (-1 = iterations)");
   require(bound_margin >= 0, "bound_margin must be >= 0");
   require(min_refine_range >= 0, "min_refine_range must be >= 0");
   require(min_disparity > 0, "min_disparity must be > 0");
@@ -427,6 +429,11 @@ void PatchMatchParams::validate() const {
   require(lr_max_diff > 0, "lr_max_diff must be > 0");
   require(num_threads >= 0, "num_threads must be >= 0 (0 = all cores)");
 }
+
+/// Per-object buffers reused across frames (a fresh full-size buffer costs page faults every frame).
+struct PatchMatchStereo::Scratch {
+  ViewState left, right;
+};
 
 PatchMatchStereo::PatchMatchStereo(const PatchMatchParams& params) { setParams(params); }
 
@@ -689,7 +696,9 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   checkInput(left, size, "left");
   checkInput(right, size, "right");
   const PatchMatchParams& p = params_;
-  ViewState lv, rv;
+  if (!scratch_) scratch_ = std::make_shared<Scratch>();
+  ViewState& lv = scratch_->left;
+  ViewState& rv = scratch_->right;
   prepareView(left, p, -1.f, lv);
   prepareView(right, p, +1.f, rv);
   const bool two_views = p.view_propagation || p.lr_check;
@@ -702,7 +711,11 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     sweep(left_solver, lv, p, it);
     if (!two_views) continue;
     if (p.view_propagation) propagateView(lv, right_solver, rv, p, true);
-    sweep(right_solver, rv, p, it);
+    // The right view's own sweeps (the last `right_iterations` of them): it serves view
+    // propagation and the left-right check, and between its sweeps it still receives the left
+    // view's refined planes by view propagation.
+    const int right_iterations = p.right_iterations < 0 ? p.iterations : p.right_iterations;
+    if (it >= p.iterations - right_iterations) sweep(right_solver, rv, p, it);
     if (p.view_propagation) propagateView(rv, left_solver, lv, p, false);
   }
 

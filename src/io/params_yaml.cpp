@@ -55,6 +55,7 @@ void visitPatchMatch(P& p, V& v) {
   v("lambda_grad", p.lambda_grad);
   v("lambda_disp", p.lambda_disp);
   v("iterations", p.iterations);
+  v("right_iterations", p.right_iterations);
   v("slanted", p.slanted);
   v("init_from_prior", p.init_from_prior);
   v("init_normal_from_prior", p.init_normal_from_prior);

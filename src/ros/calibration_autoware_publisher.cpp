@@ -33,9 +33,10 @@ void checkReprojection(const AutowareCalibration& calib, const std::string& path
   if (calib.calib_data.empty()) return;
   const double error = lidar_stereo_fusion::meanReprojectionError(calib);
   if (calib.reprojection_error >= 0 && !(error <= 2.0 * calib.reprojection_error + 1.0)) {
-    ROS_WARN("%s: CalibData reprojects with a mean error of %.2f px, the file states %.2f px; "
-             "is CameraExtrinsicMat really the camera pose in the LiDAR frame?",
-             path.c_str(), error, calib.reprojection_error);
+    ROS_WARN(
+        "%s: CalibData reprojects with a mean error of %.2f px, the file states %.2f px; "
+        "is CameraExtrinsicMat really the camera pose in the LiDAR frame?",
+        path.c_str(), error, calib.reprojection_error);
   } else {
     ROS_INFO("%s: CalibData mean reprojection error %.3f px (file states %.3f px)", path.c_str(),
              error, calib.reprojection_error);

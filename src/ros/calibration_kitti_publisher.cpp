@@ -35,9 +35,10 @@ int main(int argc, char** argv) {
   const std::string right_frame =
       pnh.param<std::string>("right_camera_frame", "right_camera_optical_frame");
   if (calib_dir.empty()) {
-    ROS_FATAL("parameter %s is not set: give the KITTI raw date folder holding "
-              "calib_cam_to_cam.txt and calib_velo_to_cam.txt",
-              pnh.resolveName("calib_dir").c_str());
+    ROS_FATAL(
+        "parameter %s is not set: give the KITTI raw date folder holding "
+        "calib_cam_to_cam.txt and calib_velo_to_cam.txt",
+        pnh.resolveName("calib_dir").c_str());
     return 1;
   }
 

@@ -9,12 +9,14 @@ namespace lidar_stereo_fusion {
 namespace {
 
 void requireRotation(const Eigen::Matrix3d& r, const std::string& what) {
-  const double orthogonality = (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orthogonality =
+      (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (!r.allFinite() || !(orthogonality <= kRotationTolerance) ||
       !(std::abs(r.determinant() - 1.0) <= kRotationTolerance)) {
     std::ostringstream msg;
-    msg << what << ": the rotation part is not a rotation matrix (max |R R^T - I| = "
-        << orthogonality << ", det = " << r.determinant() << ")";
+    msg << what
+        << ": the rotation part is not a rotation matrix (max |R R^T - I| = " << orthogonality
+        << ", det = " << r.determinant() << ")";
     throw std::invalid_argument(msg.str());
   }
 }

@@ -42,9 +42,7 @@
 #include <string>
 #include <vector>
 
-#include <boost/make_shared.hpp>
 #include <cv_bridge/cv_bridge.h>
-#include <opencv2/imgcodecs.hpp>
 #include <ros/message_traits.h>
 #include <rosbag/bag.h>
 #include <rosbag/exceptions.h>
@@ -52,8 +50,8 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_msgs/TFMessage.h>
+#include <boost/make_shared.hpp>
 
-#include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/ros/calibration_msgs.h"
 
@@ -72,7 +70,7 @@ constexpr char kRightInfoTopic[] = "/stereo/right/camera_info";
 constexpr char kCloudTopic[] = "/velodyne_points";
 constexpr char kTfStaticTopic[] = "/tf_static";
 constexpr double kDefaultSweepPeriod = 0.1;  ///< HDL-64E at 10 Hz [s], when start/end are absent
-constexpr int kHdl64Rings = 64;
+constexpr size_t kHdl64Rings = 64;
 
 /// Thrown for command-line mistakes (exit status 2).
 struct UsageError : std::runtime_error {
@@ -139,7 +137,8 @@ Options parseOptions(int argc, char** argv) {
   }
   if (options.drive_dir.empty()) throw UsageError("--kitti-raw is required");
   if (options.out.empty()) throw UsageError("--out is required");
-  if (options.calib_dir.empty()) options.calib_dir = lsf::kitti::calibrationDirOf(options.drive_dir);
+  if (options.calib_dir.empty())
+    options.calib_dir = lsf::kitti::calibrationDirOf(options.drive_dir);
   return options;
 }
 
@@ -179,7 +178,7 @@ std::string joined(const std::vector<std::string>& names) {
 struct FrameToWrite {
   lsf::kitti::Frame files;
   ros::Time image_stamp, cloud_stamp;
-  double sweep_period = kDefaultSweepPeriod;  ///< [s] timestamps_end - timestamps_start
+  double sweep_period = kDefaultSweepPeriod;       ///< [s] timestamps_end - timestamps_start
   double stamp_after_start = kDefaultSweepPeriod;  ///< [s] from the sweep start to cloud_stamp
 };
 
@@ -202,9 +201,9 @@ sensor_msgs::PointCloud2 cloudMsg(const lsf::LidarCloud& cloud, const std_msgs::
     return f;
   };
   using sensor_msgs::PointField;
-  msg.fields = {field("x", 0, PointField::FLOAT32),        field("y", 4, PointField::FLOAT32),
-                field("z", 8, PointField::FLOAT32),        field("intensity", 12, PointField::FLOAT32),
-                field("ring", 16, PointField::UINT16),     field("time", 20, PointField::FLOAT32)};
+  msg.fields = {field("x", 0, PointField::FLOAT32),    field("y", 4, PointField::FLOAT32),
+                field("z", 8, PointField::FLOAT32),    field("intensity", 12, PointField::FLOAT32),
+                field("ring", 16, PointField::UINT16), field("time", 20, PointField::FLOAT32)};
   msg.data.assign(static_cast<size_t>(msg.row_step), 0);
   bool dense = true;
   for (size_t i = 0; i < cloud.size(); ++i) {
@@ -221,37 +220,30 @@ sensor_msgs::PointCloud2 cloudMsg(const lsf::LidarCloud& cloud, const std_msgs::
   return msg;
 }
 
-/// Loads a sweep, recovers its rings and sets each point's time [s] relative to the cloud stamp
-/// from its azimuth.
-lsf::LidarCloud loadSweep(const FrameToWrite& frame) {
-  lsf::LidarCloud cloud = lsf::kitti::readVelodyneBin(frame.files.velodyne);
-  if (cloud.empty()) {
-    throw std::runtime_error("KITTI: Velodyne sweep " + frame.files.velodyne + " is empty");
-  }
-  const int rings = lsf::recoverRingsBySweepOrder(cloud);
-  if (rings != kHdl64Rings) {
-    std::cerr << "kitti_to_bag: warning: frame " << frame.files.name << ": recovered " << rings
-              << " rings, an HDL-64E sweep has " << kHdl64Rings << "\n";
-  }
+/// Sets each point's time [s] relative to the cloud stamp from its azimuth.
+void setPointTimes(const FrameToWrite& frame, lsf::LidarCloud& cloud) {
   for (lsf::LidarPoint& p : cloud) {
     const double azimuth = std::atan2(static_cast<double>(p.y), static_cast<double>(p.x));
     // Clockwise from the rear (azimuth +pi) at the sweep start to the rear again (-pi) at its end.
     const double since_start = (M_PI - azimuth) / (2.0 * M_PI) * frame.sweep_period;
     p.time = static_cast<float>(since_start - frame.stamp_after_start);
   }
-  return cloud;
 }
 
-sensor_msgs::ImagePtr imageMsg(const std::string& path, const std_msgs::Header& header,
-                               const lsf::StereoCamera& camera) {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);  // KITTI RGB PNG -> BGR
-  if (image.empty()) throw std::runtime_error("KITTI: cannot read image " + path);
-  if (image.cols != camera.width || image.rows != camera.height) {
-    throw std::runtime_error("KITTI: image " + path + " is " + std::to_string(image.cols) + "x" +
-                             std::to_string(image.rows) + " but the calibration (S_rect_02) says " +
-                             std::to_string(camera.width) + "x" + std::to_string(camera.height));
+/// Reads a frame (images checked against the calibration's size, rings recovered by sweep order).
+lsf::kitti::FrameData loadFrame(const FrameToWrite& frame, const lsf::StereoCamera& camera) {
+  lsf::kitti::FrameData data = lsf::kitti::loadFrame(frame.files, camera);
+  if (data.cloud.empty()) {
+    throw std::runtime_error("KITTI: Velodyne sweep " + frame.files.velodyne + " is empty");
   }
-  return cv_bridge::CvImage(header, "bgr8", image).toImageMsg();
+  std::set<int> rings;
+  for (const lsf::LidarPoint& p : data.cloud) rings.insert(p.ring);
+  if (rings.size() != kHdl64Rings) {
+    std::cerr << "kitti_to_bag: warning: frame " << frame.files.name << ": recovered "
+              << rings.size() << " rings, an HDL-64E sweep has " << kHdl64Rings << "\n";
+  }
+  setPointTimes(frame, data.cloud);
+  return data;
 }
 
 /// Connection header that makes `rosbag play` re-advertise the topic latched (as tf2 publishes
@@ -346,8 +338,9 @@ std::vector<FrameToWrite> selectFrames(const Options& options) {
                  "timestamps: "
               << joined(unstamped) << "\n";
   }
-  if (frames.empty()) throw std::runtime_error("KITTI: no frame of " + options.drive_dir +
-                                               " has both an image and a Velodyne timestamp");
+  if (frames.empty())
+    throw std::runtime_error("KITTI: no frame of " + options.drive_dir +
+                             " has both an image and a Velodyne timestamp");
   return frames;
 }
 
@@ -371,8 +364,10 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
   ros::Time first = frames.front().image_stamp;
   for (const auto& f : frames) first = std::min({first, f.image_stamp, f.cloud_stamp});
   tf2_msgs::TFMessage tf_static;
-  tf_static.transforms.push_back(lsf::kittiVelodyneToCamera(calib, kVelodyneFrame, kLeftFrame, first));
-  tf_static.transforms.push_back(lsf::stereoLeftToRight(calib.camera, kLeftFrame, kRightFrame, first));
+  tf_static.transforms.push_back(
+      lsf::kittiVelodyneToCamera(calib, kVelodyneFrame, kLeftFrame, first));
+  tf_static.transforms.push_back(
+      lsf::stereoLeftToRight(calib.camera, kLeftFrame, kRightFrame, first));
   bag.write(kTfStaticTopic, first, tf_static, latchedConnectionHeader<tf2_msgs::TFMessage>());
 
   uint32_t seq = 0;
@@ -388,17 +383,17 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
     sensor_msgs::CameraInfo left_info = left_info_base, right_info = right_info_base;
     left_info.header = left_header;
     right_info.header = right_header;
-    const sensor_msgs::PointCloud2 cloud = cloudMsg(loadSweep(frame), cloud_header);
+    const lsf::kitti::FrameData data = loadFrame(frame, calib.camera);
+    const sensor_msgs::PointCloud2 cloud = cloudMsg(data.cloud, cloud_header);
     bag.write(kCloudTopic, frame.cloud_stamp, cloud);
     bag.write(kLeftInfoTopic, frame.image_stamp, left_info);
     bag.write(kLeftImageTopic, frame.image_stamp,
-              imageMsg(frame.files.left_image, left_header, calib.camera));
+              cv_bridge::CvImage(left_header, "bgr8", data.left).toImageMsg());
     bag.write(kRightInfoTopic, frame.image_stamp, right_info);
     bag.write(kRightImageTopic, frame.image_stamp,
-              imageMsg(frame.files.right_image, right_header, calib.camera));
-    std::cout << "kitti_to_bag: frame " << frame.files.name << ": images at "
-              << frame.image_stamp << " s, " << cloud.width << " points at " << frame.cloud_stamp
-              << " s\n";
+              cv_bridge::CvImage(right_header, "bgr8", data.right).toImageMsg());
+    std::cout << "kitti_to_bag: frame " << frame.files.name << ": images at " << frame.image_stamp
+              << " s, " << cloud.width << " points at " << frame.cloud_stamp << " s\n";
   }
   bag.close();
   fs::rename(partialPath(options), options.out);

