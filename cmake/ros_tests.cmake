@@ -48,6 +48,7 @@ add_rostest(test/ros/rviz_screenshot.test DEPENDENCIES test_rviz_screenshot)
 
 # The simulated street as a live rig: demos, the RViz check, latency and rate measurements.
 lsf_add_ros_test_node(synthetic_publisher test/ros/synthetic_publisher.cpp)
+lsf_add_ros_test_node(measure_fusion test/ros/measure_fusion.cpp)
 
 # Launch files (tools' launch files too: their executables must exist).
 find_package(roslaunch REQUIRED)

@@ -15,7 +15,7 @@ PKGS=(
   python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev
   libgtest-dev libopencv-dev libeigen3-dev libyaml-cpp-dev
   python3-roslaunch ros-message-generation ros-message-runtime
-  xvfb imagemagick rviz
+  xvfb imagemagick rviz rosbash python3-sensor-msgs python3-stereo-msgs
 )
 
 missing=()

@@ -131,6 +131,12 @@ class OutputCollector {
     subs_.push_back(subscribe<lidar_stereo_fusion::FusionStats>(nh, "stats", &stats_));
   }
 
+  /// True when every output subscription is connected to a publisher.
+  bool connected() const {
+    return std::all_of(subs_.begin(), subs_.end(),
+                       [](const ros::Subscriber& sub) { return sub.getNumPublishers() > 0; });
+  }
+
   /// Waits until every output has a message stamped `stamp`; returns the names of those still
   /// missing (empty on success).
   std::string waitForAll(const ros::Time& stamp, double timeout_s) {
@@ -367,15 +373,16 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
   inputs["/velodyne_points"] = nh.advertise<sensor_msgs::PointCloud2>("/velodyne_points", 5);
 
   // The nodelet subscribes lazily: our output subscriptions make it subscribe to the inputs.
+  // Wait for both sides, so that neither an input nor an output message can be lost.
   const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(60.0);
   auto connected = [&] {
     for (const auto& kv : inputs) {
       if (kv.second.getNumSubscribers() == 0) return false;
     }
-    return true;
+    return outputs.connected();
   };
   while (!connected() && ros::WallTime::now() < give_up) ros::WallDuration(0.1).sleep();
-  ASSERT_TRUE(connected()) << "the fusion nodelet did not subscribe to the bag's topics";
+  ASSERT_TRUE(connected()) << "the fusion nodelet did not connect to the bag's topics and ours";
 
   // Frame by frame: sweep, then the image set, then wait for every output of that frame.
   std::vector<ros::Time> stamps;
