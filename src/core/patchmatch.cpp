@@ -420,8 +420,8 @@ void PatchMatchParams::validate() const {
   require(std::abs(alpha + beta + gamma - 1.0) < 1e-6, "alpha + beta + gamma must be 1");
   require(lambda_col > 0 && lambda_grad > 0 && lambda_disp > 0, "truncations must be > 0");
   require(iterations >= 0 && iterations <= 100, "iterations must be in [0, 100]");
-  require(right_iterations >= -1 && right_iterations <= iterations,
-          "right_iterations must be in [-1, iterations] (-1 = iterations)");
+  require(right_iterations == -1 || right_iterations >= 1,
+          "right_iterations must be -1 (every iteration) or >= 1");
   require(bound_margin >= 0, "bound_margin must be >= 0");
   require(min_refine_range >= 0, "min_refine_range must be >= 0");
   require(min_disparity > 0, "min_disparity must be > 0");
@@ -533,7 +533,7 @@ void initialise(const Solver& solver, ViewState& v, const PatchMatchParams& p, i
   }
 }
 
-constexpr int kStripRows = 24;
+constexpr int kStripRows = 12;
 
 /// One sweep of a view: strips in two phases, each strip in the paper's scan order.
 void sweep(const Solver& solver, ViewState& v, const PatchMatchParams& p, int iteration) {
@@ -651,7 +651,7 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, cv::M
   // Weighted median over the window of each filled pixel (weights exp(-L1 colour / delta)).
   std::vector<float> lut(1024);
   for (size_t i = 0; i < lut.size(); ++i) lut[i] = std::exp(-static_cast<float>(i) / delta);
-  disparity = filled.clone();
+  filled.copyTo(disparity);  // same size: no new allocation
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
     std::vector<std::pair<float, float>> samples;
@@ -707,15 +707,17 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   Solver right_solver(p, rv, lv);
   initialise(left_solver, lv, p, 0);
   if (two_views) initialise(right_solver, rv, p, 1);
+  // The right view sweeps in the last `right_iterations` iterations only. It serves view
+  // propagation and the left-right check; view propagation runs around its sweeps (left -> right
+  // before, right -> left after), since in the other iterations the right view would only hand
+  // the left view's own planes back.
+  const int right_iterations = p.right_iterations < 0 ? p.iterations
+                                                      : std::min(p.right_iterations, p.iterations);
   for (int it = 0; it < p.iterations; ++it) {
     sweep(left_solver, lv, p, it);
-    if (!two_views) continue;
+    if (!two_views || it < p.iterations - right_iterations) continue;
     if (p.view_propagation) propagateView(lv, right_solver, rv, p, true);
-    // The right view's own sweeps (the last `right_iterations` of them): it serves view
-    // propagation and the left-right check, and between its sweeps it still receives the left
-    // view's refined planes by view propagation.
-    const int right_iterations = p.right_iterations < 0 ? p.iterations : p.right_iterations;
-    if (it >= p.iterations - right_iterations) sweep(right_solver, rv, p, it);
+    sweep(right_solver, rv, p, it);
     if (p.view_propagation) propagateView(rv, left_solver, lv, p, false);
   }
 

@@ -1,7 +1,13 @@
 #include "lidar_stereo_fusion/ros/fusion_worker.h"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <numeric>
 #include <sstream>
@@ -74,6 +80,8 @@ NodeParams NodeParams::read(const ros::NodeHandle& pnh) {
   readChecked(pnh, "num_rings", p.num_rings, positive, "must be > 0");
   readChecked(pnh, "cloud_stride", p.cloud_stride, positive, "must be > 0");
   readChecked(pnh, "max_output_depth", p.max_output_depth, non_negative, "must be >= 0 [m]");
+  readChecked(pnh, "worker_nice", p.worker_nice, [](int v) { return v >= 0 && v <= 19; },
+              "must be in [0, 19]");
   readChecked(pnh, "diagnostics/min_rate", p.diag_min_rate, non_negative, "must be >= 0 [Hz]");
   readChecked(pnh, "diagnostics/max_rate", p.diag_max_rate, positive, "must be > 0 [Hz]");
   readChecked(pnh, "diagnostics/max_latency", p.diag_max_latency, positive, "must be > 0 [s]");
@@ -425,6 +433,16 @@ void FusionWorker::reconfigureCb(FusionConfig& config, uint32_t /*level*/) {
 // Worker thread
 // -------------------------------------------------------------------------------------------------
 void FusionWorker::workerLoop() {
+  if (node_params_.worker_nice > 0) {
+    // Linux: the nice value is per thread and inherited by the threads this one creates (OpenMP).
+    const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+    errno = 0;
+    const int current = getpriority(PRIO_PROCESS, tid);
+    if (errno != 0 || setpriority(PRIO_PROCESS, tid, current + node_params_.worker_nice) != 0) {
+      ROS_WARN_STREAM("[" << name_ << "] could not lower the priority of the worker thread: "
+                          << std::strerror(errno));
+    }
+  }
   FusionParams params;
   {
     std::lock_guard<std::mutex> lock(params_mutex_);

@@ -44,8 +44,10 @@ void visitParams(FusionParams& p, Visitor&& v) {
   v("patchmatch", "lambda_grad", m.lambda_grad);
   v("patchmatch", "lambda_disp", m.lambda_disp);
   v("patchmatch", "iterations", m.iterations);
+  v("patchmatch", "right_iterations", m.right_iterations);
   v("patchmatch", "slanted", m.slanted);
   v("patchmatch", "init_from_prior", m.init_from_prior);
+  v("patchmatch", "init_normal_from_prior", m.init_normal_from_prior);
   v("patchmatch", "use_lidar_bounds", m.use_lidar_bounds);
   v("patchmatch", "bound_margin", m.bound_margin);
   v("patchmatch", "min_refine_range", m.min_refine_range);

@@ -150,7 +150,7 @@ TEST(PatchMatch, RejectsBadInput) {
   p.alpha = 0.5;  // sum != 1
   EXPECT_THROW(p.validate(), std::invalid_argument);
   lsf::PatchMatchParams q;
-  q.right_iterations = q.iterations + 1;
+  q.right_iterations = 0;
   EXPECT_THROW(q.validate(), std::invalid_argument);
   q.right_iterations = -2;
   EXPECT_THROW(q.validate(), std::invalid_argument);

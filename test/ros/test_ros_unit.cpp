@@ -511,17 +511,44 @@ TEST(RosParams, UnknownMethodInReconfigureIsNamed) {
   }
 }
 
+namespace {
+/// A YAML file as an OpenCV FileStorage (rosparam files have no "%YAML:1.0" directive).
+cv::FileStorage openRosparamYaml(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << "%YAML:1.0\n---\n" << in.rdbuf();
+  return cv::FileStorage(text.str(), cv::FileStorage::READ | cv::FileStorage::MEMORY);
+}
+}  // namespace
+
+TEST(RosParams, EveryFieldTheCoreYamlWriterKnowsIsARosParameter) {
+  // saveParamsYaml writes every field of FusionParams: a field added to the core must also be
+  // added to ros_params.cpp and cfg/Fusion.cfg.
+  const std::string path = std::string(LSF_BINARY_DIR) + "/test_ros_unit_params.yaml";
+  lsf::saveParamsYaml(path, lsf::FusionParams());
+  cv::FileStorage fs = openRosparamYaml(path);
+  ASSERT_TRUE(fs.isOpened());
+  std::set<std::string> core;
+  for (const cv::FileNode& node : fs.root()) {
+    if (node.isMap()) {
+      for (const cv::FileNode& field : node) core.insert(node.name() + "/" + field.name());
+    } else {
+      core.insert(node.name());
+    }
+  }
+  std::set<std::string> ros;
+  for (const auto& info : lsf::ros_params::listParams()) ros.insert(info.ros_name);
+  for (const auto& name : core) EXPECT_TRUE(ros.count(name)) << name << " is not a ROS parameter";
+  for (const auto& name : ros) EXPECT_TRUE(core.count(name)) << name << " is not a core field";
+}
+
 TEST(RosParams, ShippedYamlHasEveryParameterAndLoadsInTheCore) {
   const std::string path = std::string(LSF_SOURCE_DIR) + "/config/fusion.yaml";
   lsf::FusionParams loaded;
   ASSERT_NO_THROW(lsf::loadParamsYaml(path, loaded));
   EXPECT_EQ(lsf::ros_params::describeChanges(lsf::FusionParams(), loaded), "")
       << "config/fusion.yaml documents the paper's values, which are the struct defaults";
-  // rosparam files have no "%YAML:1.0" directive, which OpenCV's reader needs.
-  std::ifstream in(path);
-  std::stringstream text;
-  text << "%YAML:1.0\n---\n" << in.rdbuf();
-  cv::FileStorage fs(text.str(), cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  cv::FileStorage fs = openRosparamYaml(path);
   ASSERT_TRUE(fs.isOpened());
   for (const auto& info : lsf::ros_params::listParams()) {
     const auto slash = info.ros_name.find('/');

@@ -25,17 +25,17 @@ struct PatchMatchParams {
   double lambda_grad = 2.0;      ///< gradient truncation
   double lambda_disp = 2.0;      ///< disparity truncation [px]; also the cost where the prior is empty
   int iterations = 3;
-  /// Sweeps of the right view (the last ones of `iterations`); -1 = all (Bleyer). The right view
+  /// Sweeps of the right view (the last min(k, iterations)); -1 = all (Bleyer). The right view
   /// serves view propagation and the left-right check and receives the left view's refined planes
-  /// by view propagation every iteration; one own sweep was as accurate on KITTI and Middlebury
-  /// as three and saves ~40 % of the time.
+  /// by view propagation before each of its sweeps; one sweep was as accurate on KITTI and
+  /// Middlebury as three and saves ~40 % of the time.
   int right_iterations = 1;
   bool slanted = true;           ///< false: front-parallel windows (n = (0, 0, 1))
   bool init_from_prior = true;   ///< d = prior where it exists, else random
   bool init_normal_from_prior = true;  ///< slanted: initial normal from the prior's local slope
   bool use_lidar_bounds = true;  ///< limit d to the scan lines above/below (+- bound_margin)
   double bound_margin = 1.0;     ///< [px]
-  double min_refine_range = 1.0; ///< floor of Delta_d_max between scan lines [px]
+  double min_refine_range = 0.5; ///< floor of Delta_d_max between scan lines [px]
   double min_disparity = 1.0;    ///< image-wide search range [px]
   double max_disparity = 192.0;  ///< [px]
   bool view_propagation = true;

@@ -62,6 +62,10 @@ struct NodeParams {
   int num_rings = 64;             ///< rings recovered by elevation for clouds without `ring`
   int cloud_stride = 1;           ///< points2 keeps every k-th pixel in rows and columns
   double max_output_depth = 0.0;  ///< [m] depth / points2 beyond this are empty (0 = no limit)
+  /// Nice increment of the worker thread (and so of the OpenMP threads it starts): the pipeline
+  /// uses every core, and ROS callbacks, nodelet bond heartbeats and drivers in the same machine
+  /// must still be served on time. 0 = same priority as the callbacks.
+  int worker_nice = 10;
   double diag_min_rate = 1.0;     ///< [Hz] diagnostics: lowest acceptable output rate
   double diag_max_rate = 100.0;   ///< [Hz] diagnostics: highest acceptable output rate
   double diag_max_latency = 2.0;  ///< [s] diagnostics: largest acceptable stamp -> publish delay
