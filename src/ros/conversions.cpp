@@ -6,11 +6,11 @@
 #include <limits>
 #include <sstream>
 
-#include <boost/make_shared.hpp>
 #include <cv_bridge/cv_bridge.h>
-#include <opencv2/imgproc.hpp>
 #include <sensor_msgs/image_encodings.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <boost/make_shared.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace lidar_stereo_fusion {
 namespace conversions {
@@ -41,8 +41,8 @@ bool isSupported(const std::string& encoding) {
 std::string checkImage(const sensor_msgs::Image& msg) {
   std::ostringstream problem;
   if (!isSupported(msg.encoding)) {
-    problem << "unsupported encoding '" << msg.encoding << "' (supported: "
-            << joined(supportedImageEncodings()) << ")";
+    problem << "unsupported encoding '" << msg.encoding
+            << "' (supported: " << joined(supportedImageEncodings()) << ")";
   } else if (msg.width == 0 || msg.height == 0) {
     problem << "empty image (" << msg.width << "x" << msg.height << ")";
   } else if (msg.step < msg.width * static_cast<uint32_t>(enc::numChannels(msg.encoding))) {
@@ -77,8 +77,9 @@ cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg) {
   return out;
 }
 
-void stereoPairToCore(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right,
-                      cv::Mat& left_out, cv::Mat& right_out) {
+void stereoPairToCore(const sensor_msgs::ImageConstPtr& left,
+                      const sensor_msgs::ImageConstPtr& right, cv::Mat& left_out,
+                      cv::Mat& right_out) {
   if (left->width != right->width || left->height != right->height) {
     std::ostringstream s;
     s << "left image is " << left->width << "x" << left->height << " but right image is "
@@ -126,9 +127,9 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
   camera.width = static_cast<int>(left.width);
   camera.height = static_cast<int>(left.height);
   if (!(camera.baseline > 0.0) || !std::isfinite(camera.baseline)) {
-    throw ConversionError("right camera_info: P[3] (Tx = -fx * baseline) is " +
-                          std::to_string(Pr[3]) +
-                          ", equal to the left one: no baseline (is this the right camera's info?)");
+    throw ConversionError(
+        "right camera_info: P[3] (Tx = -fx * baseline) is " + std::to_string(Pr[3]) +
+        ", equal to the left one: no baseline (is this the right camera's info?)");
   }
   return camera;
 }
@@ -288,8 +289,8 @@ CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg) {
       if (fi.present) point.intensity = static_cast<float>(readField(p + fi.offset, fi.datatype));
       if (fr.present) {
         const double ring = readField(p + fr.offset, fr.datatype);
-        point.ring = std::isfinite(ring) && ring >= 0.0 && ring < 65536.0 ? static_cast<int>(ring)
-                                                                          : -1;
+        point.ring =
+            std::isfinite(ring) && ring >= 0.0 && ring < 65536.0 ? static_cast<int>(ring) : -1;
       }
       if (ft.present) {
         const double t = readField(p + ft.offset, ft.datatype);
@@ -395,8 +396,8 @@ sensor_msgs::ImagePtr depthToMsg(const cv::Mat1f& depth, const std_msgs::Header&
                                  double max_depth) {
   auto msg = boost::make_shared<sensor_msgs::Image>(floatImage(depth, header));
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  const float limit = max_depth > 0.0 ? static_cast<float>(max_depth)
-                                      : std::numeric_limits<float>::infinity();
+  const float limit =
+      max_depth > 0.0 ? static_cast<float>(max_depth) : std::numeric_limits<float>::infinity();
   float* data = reinterpret_cast<float*>(msg->data.data());
   const size_t n = static_cast<size_t>(depth.rows) * depth.cols;
   for (size_t i = 0; i < n; ++i) {

@@ -10,8 +10,9 @@ int main(int argc, char** argv) {
   const nodelet::V_string nodelet_argv(argv + 1, argv + argc);
   if (!loader.load(ros::this_node::getName(), "lidar_stereo_fusion/FusionNodelet", remappings,
                    nodelet_argv)) {
-    ROS_FATAL("fusion_node: could not load lidar_stereo_fusion/FusionNodelet "
-              "(is the package's devel/setup.bash sourced?)");
+    ROS_FATAL(
+        "fusion_node: could not load lidar_stereo_fusion/FusionNodelet "
+        "(is the package's devel/setup.bash sourced?)");
     return 1;
   }
   ros::spin();

@@ -13,9 +13,9 @@
 #include <sstream>
 #include <utility>
 
+#include <tf2_eigen/tf2_eigen.h>
 #include <boost/bind/bind.hpp>
 #include <boost/make_shared.hpp>
-#include <tf2_eigen/tf2_eigen.h>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
@@ -42,7 +42,8 @@ std::string stampText(const ros::Time& t) {
 }
 
 double msSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 /// Reads `name` and keeps the current value (with an error naming the parameter) when `ok` fails.
@@ -80,8 +81,9 @@ NodeParams NodeParams::read(const ros::NodeHandle& pnh) {
   readChecked(pnh, "num_rings", p.num_rings, positive, "must be > 0");
   readChecked(pnh, "cloud_stride", p.cloud_stride, positive, "must be > 0");
   readChecked(pnh, "max_output_depth", p.max_output_depth, non_negative, "must be >= 0 [m]");
-  readChecked(pnh, "worker_nice", p.worker_nice, [](int v) { return v >= 0 && v <= 19; },
-              "must be in [0, 19]");
+  readChecked(
+      pnh, "worker_nice", p.worker_nice, [](int v) { return v >= 0 && v <= 19; },
+      "must be in [0, 19]");
   readChecked(pnh, "diagnostics/min_rate", p.diag_min_rate, non_negative, "must be >= 0 [Hz]");
   readChecked(pnh, "diagnostics/max_rate", p.diag_max_rate, positive, "must be > 0 [Hz]");
   readChecked(pnh, "diagnostics/max_latency", p.diag_max_latency, positive, "must be > 0 [s]");
@@ -101,7 +103,8 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
       updater_(nh, pnh, name),
       output_frequency_(diagnostic_updater::FrequencyStatusParam(
           &node_params_.diag_min_rate, &node_params_.diag_max_rate, 0.1, 10)),
-      output_stamps_(diagnostic_updater::TimeStampStatusParam(-1.0, node_params_.diag_max_latency)) {
+      output_stamps_(
+          diagnostic_updater::TimeStampStatusParam(-1.0, node_params_.diag_max_latency)) {
   // Core parameters: the defaults of the structs, overridden by what is on the parameter server.
   std::vector<std::string> errors;
   FusionParams params = ros_params::readParams(pnh_, FusionParams(), &errors);
@@ -125,13 +128,13 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
   // Synchroniser of the image set (connected once; the filters are (un)subscribed lazily).
   it_ = std::make_shared<image_transport::ImageTransport>(nh_);
   if (node_params_.approximate_sync) {
-    approx_sync_ = std::make_shared<ApproxSync>(ApproxPolicy(node_params_.queue_size),
-                                                sub_left_image_, sub_left_info_, sub_right_image_,
-                                                sub_right_info_);
+    approx_sync_ =
+        std::make_shared<ApproxSync>(ApproxPolicy(node_params_.queue_size), sub_left_image_,
+                                     sub_left_info_, sub_right_image_, sub_right_info_);
     approx_sync_->setReset(true);  // clears its queues when simulated time jumps back
-    approx_sync_->registerCallback(boost::bind(&FusionWorker::imageCb, this, boost::placeholders::_1,
-                                               boost::placeholders::_2, boost::placeholders::_3,
-                                               boost::placeholders::_4));
+    approx_sync_->registerCallback(boost::bind(&FusionWorker::imageCb, this,
+                                               boost::placeholders::_1, boost::placeholders::_2,
+                                               boost::placeholders::_3, boost::placeholders::_4));
   } else {
     exact_sync_ = std::make_shared<ExactSync>(ExactPolicy(node_params_.queue_size), sub_left_image_,
                                               sub_left_info_, sub_right_image_, sub_right_info_);
@@ -145,19 +148,18 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
   }
 
   // Live parameters: start from the values just read, then follow dynamic_reconfigure.
-  reconfigure_server_ = std::make_unique<dynamic_reconfigure::Server<FusionConfig>>(reconfigure_mutex_, pnh_);
+  reconfigure_server_ =
+      std::make_unique<dynamic_reconfigure::Server<FusionConfig>>(reconfigure_mutex_, pnh_);
   reconfigure_server_->updateConfig(ros_params::toConfig(params_));
-  reconfigure_server_->setCallback(
-      boost::bind(&FusionWorker::reconfigureCb, this, boost::placeholders::_1,
-                  boost::placeholders::_2));
+  reconfigure_server_->setCallback(boost::bind(&FusionWorker::reconfigureCb, this,
+                                               boost::placeholders::_1, boost::placeholders::_2));
 
   // Diagnostics.
   updater_.setHardwareID("none");
   updater_.add("output", this, &FusionWorker::diagnoseOutput);
   updater_.add("processing", this, &FusionWorker::diagnoseProcessing);
-  diag_timer_ = nh_.createTimer(ros::Duration(0.5), [this](const ros::TimerEvent&) {
-    updater_.update();
-  });
+  diag_timer_ =
+      nh_.createTimer(ros::Duration(0.5), [this](const ros::TimerEvent&) { updater_.update(); });
 
   worker_ = std::thread(&FusionWorker::workerLoop, this);
   advertise();  // last: connect callbacks may subscribe right away
@@ -201,12 +203,11 @@ void FusionWorker::advertise() {
 
 void FusionWorker::connectCb() {
   std::lock_guard<std::mutex> lock(connect_mutex_);
-  const uint32_t subscribers = pub_disparity_.getNumSubscribers() +
-                               pub_points_.getNumSubscribers() + pub_stats_.getNumSubscribers() +
-                               pub_depth_.getNumSubscribers() +
-                               pub_depth_info_.getNumSubscribers() +
-                               pub_lidar_disparity_.getNumSubscribers() +
-                               pub_disparity_image_.getNumSubscribers();
+  const uint32_t subscribers =
+      pub_disparity_.getNumSubscribers() + pub_points_.getNumSubscribers() +
+      pub_stats_.getNumSubscribers() + pub_depth_.getNumSubscribers() +
+      pub_depth_info_.getNumSubscribers() + pub_lidar_disparity_.getNumSubscribers() +
+      pub_disparity_image_.getNumSubscribers();
   if (subscribers == 0 && subscribed_) {
     unsubscribe();
   } else if (subscribers > 0 && !subscribed_) {
@@ -280,9 +281,8 @@ bool FusionWorker::checkImageSet(const ImageSet& set) {
   const auto reject = [this](const std::string& topic, const std::string& problem,
                              const ros::Time& stamp) {
     ++counters_.invalid;
-    warnThrottled(topic + problem,
-                  topicName(topic) + ": " + problem + " (stamp " + stampText(stamp) +
-                      "); image set skipped");
+    warnThrottled(topic + problem, topicName(topic) + ": " + problem + " (stamp " +
+                                       stampText(stamp) + "); image set skipped");
     return false;
   };
   const ros::Time stamp = set.left->header.stamp;
@@ -344,10 +344,14 @@ void FusionWorker::syncDropCb(const ImageConstPtr& left, const InfoConstPtr& lef
   if (!right) missing += std::string(" ") + topicName(kRightImage);
   if (!right_info) missing += std::string(" ") + topicName(kRightInfo);
   ros::Time stamp;
-  if (left) stamp = left->header.stamp;
-  else if (right) stamp = right->header.stamp;
-  else if (left_info) stamp = left_info->header.stamp;
-  else if (right_info) stamp = right_info->header.stamp;
+  if (left)
+    stamp = left->header.stamp;
+  else if (right)
+    stamp = right->header.stamp;
+  else if (left_info)
+    stamp = left_info->header.stamp;
+  else if (right_info)
+    stamp = right_info->header.stamp;
   warnThrottled("sync_drop", "incomplete image set at stamp " + stampText(stamp) +
                                  " dropped by the exact-time synchroniser; missing:" + missing +
                                  " (different stamps? then set ~approximate_sync true)");
@@ -355,16 +359,15 @@ void FusionWorker::syncDropCb(const ImageConstPtr& left, const InfoConstPtr& lef
 
 void FusionWorker::cloudCb(const CloudConstPtr& cloud) {
   const ros::Time stamp = cloud->header.stamp;
-  ROS_DEBUG_STREAM("[" << name_ << "] sweep " << stampText(stamp) << " (" << cloud->width * cloud->height
-                       << " points)");
+  ROS_DEBUG_STREAM("[" << name_ << "] sweep " << stampText(stamp) << " ("
+                       << cloud->width * cloud->height << " points)");
   std::string problem = conversions::checkCloudLayout(*cloud);
   if (problem.empty() && cloud->width * cloud->height == 0) problem = "empty cloud (0 points)";
   if (problem.empty() && cloud->header.frame_id.empty()) problem = "empty frame_id";
   if (!problem.empty()) {
     ++counters_.invalid;
-    warnThrottled(std::string(kCloud) + problem,
-                  topicName(kCloud) + ": " + problem + " (stamp " + stampText(stamp) +
-                      "); sweep skipped");
+    warnThrottled(std::string(kCloud) + problem, topicName(kCloud) + ": " + problem + " (stamp " +
+                                                     stampText(stamp) + "); sweep skipped");
     return;
   }
   std::lock_guard<std::mutex> lock(data_mutex_);
@@ -376,6 +379,13 @@ void FusionWorker::cloudCb(const CloudConstPtr& cloud) {
 void FusionWorker::handleEvents(Matcher::Events& events, const std::string& topic,
                                 const ros::Time& stamp) {
   // Called with data_mutex_ held.
+  if (events.restarted) {
+    counters_.dropped += static_cast<uint32_t>(events.discarded);
+    ROS_INFO_STREAM(
+        "[" << name_ << "] " << topicName(topic) << ": stamp " << stampText(stamp)
+            << " is more than " << matcher_.params().restart_step
+            << " s older than the last one: time restarted (bag loop?), buffers cleared");
+  }
   if (events.out_of_order) {
     ++counters_.out_of_order;
     warnThrottled(topic + "order", topicName(topic) + ": stamp " + stampText(stamp) +
@@ -384,15 +394,16 @@ void FusionWorker::handleEvents(Matcher::Events& events, const std::string& topi
   }
   for (const ros::Time& t : events.unmatched) {
     ++counters_.unmatched;
-    warnThrottled("unmatched",
-                  "no sweep on " + topicName(kCloud) + " within " +
-                      std::to_string(node_params_.max_time_offset) + " s of the image set at " +
-                      stampText(t) + "; image set skipped (is the LiDAR publishing? raise "
-                                     "~max_time_offset if the clocks differ)");
+    warnThrottled("unmatched", "no sweep on " + topicName(kCloud) + " within " +
+                                   std::to_string(node_params_.max_time_offset) +
+                                   " s of the image set at " + stampText(t) +
+                                   "; image set skipped (is the LiDAR publishing? raise "
+                                   "~max_time_offset if the clocks differ)");
   }
   if (events.ready.empty()) return;
-  ROS_DEBUG_STREAM("[" << name_ << "] matched image set " << stampText(events.ready.back().image_stamp)
-                       << " with sweep " << stampText(events.ready.back().sweep_stamp));
+  ROS_DEBUG_STREAM("[" << name_ << "] matched image set "
+                       << stampText(events.ready.back().image_stamp) << " with sweep "
+                       << stampText(events.ready.back().sweep_stamp));
   // Only the newest set is worth processing: older ones (and a set still waiting for the worker)
   // are dropped and counted, so a slow pipeline never builds a backlog.
   const std::size_t superseded = events.ready.size() - 1 + (next_job_ ? 1 : 0);
@@ -413,8 +424,8 @@ void FusionWorker::reconfigureCb(FusionConfig& config, uint32_t /*level*/) {
     candidate.validate();
   } catch (const std::exception& e) {
     std::string changes = ros_params::describeChanges(current, candidate);
-    ROS_ERROR_STREAM("[" << name_ << "] rejected parameter change (" << changes << "): "
-                         << e.what() << "; keeping the previous parameters");
+    ROS_ERROR_STREAM("[" << name_ << "] rejected parameter change (" << changes << "): " << e.what()
+                         << "; keeping the previous parameters");
     config = ros_params::toConfig(current);  // the server publishes the values in use
     return;
   }
@@ -507,7 +518,8 @@ void FusionWorker::processMatch(const Match& match, FusionPipeline& pipeline) {
   } catch (const conversions::ConversionError& e) {
     ++counters_.invalid;
     warnThrottled("convert", std::string("cannot convert the input set at ") +
-                                 stampText(match.image_stamp) + ": " + e.what() + "; frame skipped");
+                                 stampText(match.image_stamp) + ": " + e.what() +
+                                 "; frame skipped");
     return;
   }
   if (cloud.cloud.empty()) {
@@ -536,16 +548,16 @@ void FusionWorker::processMatch(const Match& match, FusionPipeline& pipeline) {
     result = pipeline.process(input);
   } catch (const std::exception& e) {
     ++counters_.errors;
-    warnThrottled("process", "fusion failed on the frame at " + stampText(match.image_stamp) +
-                                 ": " + e.what() + "; frame skipped",
+    warnThrottled("process",
+                  "fusion failed on the frame at " + stampText(match.image_stamp) + ": " +
+                      e.what() + "; frame skipped",
                   true);
     return;
   }
   ROS_DEBUG_STREAM("[" << name_ << "] processed " << stampText(match.image_stamp) << " in "
                        << result.stats.total_ms << " ms");
   publishOutputs(match, input.camera, input.left, result, pipeline.params(),
-                 static_cast<int>(input.cloud.size()), rings, rings_recovered,
-                 conversion_ms);
+                 static_cast<int>(input.cloud.size()), rings, rings_recovered, conversion_ms);
 }
 
 void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera,
@@ -555,7 +567,8 @@ void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera
   const auto out_start = Clock::now();
   const std_msgs::Header& header = match.images.left->header;
   cv::Mat1f depth = result.depth;
-  if (depth.empty() && !result.disparity.empty()) depth = disparityToDepth(result.disparity, camera);
+  if (depth.empty() && !result.disparity.empty())
+    depth = disparityToDepth(result.disparity, camera);
 
   stereo_msgs::DisparityImagePtr disparity_msg;
   sensor_msgs::ImagePtr depth_msg, prior_msg, disparity_image_msg;
@@ -671,8 +684,7 @@ void FusionWorker::diagnoseProcessing(diagnostic_updater::DiagnosticStatusWrappe
     if (n > 0) {
       mean_ms = std::accumulate(recent_total_ms_.begin(), recent_total_ms_.end(), 0.0) / n;
       max_ms = *std::max_element(recent_total_ms_.begin(), recent_total_ms_.end());
-      mean_latency =
-          std::accumulate(recent_latency_ms_.begin(), recent_latency_ms_.end(), 0.0) / n;
+      mean_latency = std::accumulate(recent_latency_ms_.begin(), recent_latency_ms_.end(), 0.0) / n;
     }
   }
   const uint32_t problems = counters_.dropped + counters_.unmatched + counters_.tf_failures +

@@ -22,10 +22,10 @@
 namespace {
 
 struct Sample {
-  double receipt;       ///< [s] wall
-  double latency_ms;    ///< stamp -> publish, from FusionStats
-  double receipt_ms;    ///< stamp -> receipt here
-  double total_ms;      ///< core pipeline
+  double receipt;     ///< [s] wall
+  double latency_ms;  ///< stamp -> publish, from FusionStats
+  double receipt_ms;  ///< stamp -> receipt here
+  double total_ms;    ///< core pipeline
   uint32_t dropped, unmatched, processed;
 };
 
@@ -46,12 +46,17 @@ int main(int argc, char** argv) {
 
   std::mutex mutex;
   std::vector<Sample> samples;
+  int skipped = 0;
   const ros::WallTime start = ros::WallTime::now();
   auto stats_sub = nh.subscribe<lidar_stereo_fusion::FusionStats>(
       ns + "/stats", 50, [&](const lidar_stereo_fusion::FusionStatsConstPtr& s) {
         const ros::WallTime now = ros::WallTime::now();
         if ((now - start).toSec() < warmup) return;
         std::lock_guard<std::mutex> lock(mutex);
+        if (s->latency_ms < 0.0) {  // simulated time jumped back (bag loop) meanwhile
+          ++skipped;
+          return;
+        }
         samples.push_back({now.toSec(), s->latency_ms,
                            (ros::Time::now() - s->header.stamp).toSec() * 1e3, s->total_ms,
                            s->dropped_frames, s->unmatched_frames, s->processed_frames});
@@ -65,8 +70,8 @@ int main(int argc, char** argv) {
   keep.push_back(nh.subscribe<sensor_msgs::PointCloud2>(
       ns + "/points2", 1, +[](const sensor_msgs::PointCloud2ConstPtr&) {}));
   for (const char* image : {"/depth", "/lidar_disparity", "/disparity_image"}) {
-    keep.push_back(nh.subscribe<sensor_msgs::Image>(ns + image, 1,
-                                                    +[](const sensor_msgs::ImageConstPtr&) {}));
+    keep.push_back(nh.subscribe<sensor_msgs::Image>(
+        ns + image, 1, +[](const sensor_msgs::ImageConstPtr&) {}));
   }
 
   ros::AsyncSpinner spinner(2);
@@ -91,14 +96,16 @@ int main(int argc, char** argv) {
       "  latency image stamp -> publish [ms]: mean %.0f  median %.0f  p95 %.0f  max %.0f\n"
       "  latency image stamp -> receipt [ms]: mean %.0f  median %.0f  p95 %.0f\n"
       "  core pipeline [ms]:                  mean %.0f  median %.0f  max %.0f\n"
-      "  meanwhile: %u sets dropped (newer one waiting), %u unmatched\n",
+      "  meanwhile: %u sets dropped (newer one waiting), %u unmatched; %d frames across a time "
+      "jump "
+      "not counted\n",
       samples.size(), span, (samples.size() - 1) / span,
-      std::accumulate(latency.begin(), latency.end(), 0.0) / latency.size(), percentile(latency, 0.5),
-      percentile(latency, 0.95), percentile(latency, 1.0),
-      std::accumulate(receipt.begin(), receipt.end(), 0.0) / receipt.size(), percentile(receipt, 0.5),
-      percentile(receipt, 0.95), std::accumulate(total.begin(), total.end(), 0.0) / total.size(),
-      percentile(total, 0.5), percentile(total, 1.0),
-      samples.back().dropped - samples.front().dropped,
-      samples.back().unmatched - samples.front().unmatched);
+      std::accumulate(latency.begin(), latency.end(), 0.0) / latency.size(),
+      percentile(latency, 0.5), percentile(latency, 0.95), percentile(latency, 1.0),
+      std::accumulate(receipt.begin(), receipt.end(), 0.0) / receipt.size(),
+      percentile(receipt, 0.5), percentile(receipt, 0.95),
+      std::accumulate(total.begin(), total.end(), 0.0) / total.size(), percentile(total, 0.5),
+      percentile(total, 1.0), samples.back().dropped - samples.front().dropped,
+      samples.back().unmatched - samples.front().unmatched, skipped);
   return 0;
 }

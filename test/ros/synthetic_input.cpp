@@ -2,10 +2,10 @@
 
 #include <cstring>
 
-#include <boost/make_shared.hpp>
-#include <opencv2/imgproc.hpp>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
+#include <boost/make_shared.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "lidar_stereo_fusion/ros/conversions.h"
 

@@ -9,10 +9,10 @@
 #include <vector>
 
 #include <geometry_msgs/TransformStamped.h>
-#include <opencv2/core.hpp>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <opencv2/core.hpp>
 
 #include "lidar_stereo_fusion/core/types.h"
 #include "lidar_stereo_fusion/sim/synthetic_frame.h"

@@ -38,8 +38,8 @@ int main(int argc, char** argv) {
   auto right_info = nh.advertise<sensor_msgs::CameraInfo>("/stereo/right/camera_info", 2);
   auto cloud = nh.advertise<sensor_msgs::PointCloud2>("/velodyne_points", 2);
   tf2_ros::StaticTransformBroadcaster tf;
-  auto transform =
-      lsf::test::lidarToCameraTf(frames[0].T_cam_lidar, lsf::test::kCameraFrame, lsf::test::kLidarFrame);
+  auto transform = lsf::test::lidarToCameraTf(frames[0].T_cam_lidar, lsf::test::kCameraFrame,
+                                              lsf::test::kLidarFrame);
   transform.header.stamp = ros::Time::now();
   tf.sendTransform(transform);
   ROS_INFO("synthetic_publisher: publishing at %.1f Hz", rate);
@@ -49,9 +49,11 @@ int main(int argc, char** argv) {
     const auto& f = frames[i % frames.size()];
     const ros::Time stamp = ros::Time::now();
     left_info.publish(lsf::test::cameraInfoMsg(f.camera, false, lsf::test::kCameraFrame, stamp));
-    right_info.publish(lsf::test::cameraInfoMsg(f.camera, true, lsf::test::kRightCameraFrame, stamp));
+    right_info.publish(
+        lsf::test::cameraInfoMsg(f.camera, true, lsf::test::kRightCameraFrame, stamp));
     left_image.publish(lsf::test::imageMsg(f.left, encoding, lsf::test::kCameraFrame, stamp));
-    right_image.publish(lsf::test::imageMsg(f.right, encoding, lsf::test::kRightCameraFrame, stamp));
+    right_image.publish(
+        lsf::test::imageMsg(f.right, encoding, lsf::test::kRightCameraFrame, stamp));
     if (publish_cloud) cloud.publish(lsf::test::cloudMsg(f.cloud, lsf::test::kLidarFrame, stamp));
     ros::spinOnce();
     loop.sleep();

@@ -52,8 +52,8 @@ constexpr double kOutputTimeout = 20.0;  ///< [s] first frame includes pipeline 
 constexpr double kNoOutputWait = 1.5;    ///< [s] > max_sweep_wait + processing of a small frame
 
 /// The output topics, relative to the fusion namespace.
-const std::vector<std::string> kOutputs = {"disparity",       "depth",           "depth/camera_info",
-                                           "points2",         "lidar_disparity", "disparity_image",
+const std::vector<std::string> kOutputs = {"disparity", "depth",           "depth/camera_info",
+                                           "points2",   "lidar_disparity", "disparity_image",
                                            "stats"};
 
 /// How one input set is made.
@@ -64,9 +64,9 @@ struct SetSpec {
   enum class Cloud { kNormal, kNone, kEmpty, kNaN, kNoRing, kCustom } cloud = Cloud::kNormal;
   sensor_msgs::PointCloud2Ptr custom_cloud;
   std::string cloud_frame = kLidarFrame;
-  double cloud_offset = 0.0;  ///< sweep stamp - image stamp [s]
-  bool cloud_first = false;   ///< publish the sweep before the images
-  bool positive_tx = false;   ///< right camera_info with Tx = +fx * B
+  double cloud_offset = 0.0;        ///< sweep stamp - image stamp [s]
+  bool cloud_first = false;         ///< publish the sweep before the images
+  bool positive_tx = false;         ///< right camera_info with Tx = +fx * B
   double right_stamp_offset = 0.0;  ///< right image/info stamp - left stamp [s]
 };
 
@@ -156,7 +156,8 @@ class Harness {
       right_bgr = frame.right(cv::Rect(0, 0, spec.right_width, frame.right.rows)).clone();
       right_camera.width = spec.right_width;
     }
-    auto right = lsf::test::imageMsg(right_bgr, spec.right_encoding, kRightCameraFrame, right_stamp);
+    auto right =
+        lsf::test::imageMsg(right_bgr, spec.right_encoding, kRightCameraFrame, right_stamp);
     auto linfo = lsf::test::cameraInfoMsg(frame.camera, false, kCameraFrame, stamp);
     auto rinfo = lsf::test::cameraInfoMsg(right_camera, true, kRightCameraFrame, right_stamp,
                                           spec.positive_tx);
@@ -189,8 +190,8 @@ class Harness {
               record("points2", m->header, [&] { points_ = m; });
             }));
       } else if (name == "stats") {
-        subs_.push_back(nh_.subscribe<lsf::FusionStats>(
-            topic, 20, [this](const lsf::FusionStatsConstPtr& m) {
+        subs_.push_back(
+            nh_.subscribe<lsf::FusionStats>(topic, 20, [this](const lsf::FusionStatsConstPtr& m) {
               record("stats", m->header, [&] { stats_ = m; });
             }));
       } else {  // images
@@ -761,7 +762,8 @@ TEST_F(FusionNode, L_DiagnosticsReportRateAndProcessingTime) {
   for (const auto& kv : seen) {
     if (kv.first.find(": processing") == std::string::npos) continue;
     bool has_time = false;
-    for (const auto& v : kv.second.values) has_time = has_time || v.key == "processing time mean [ms]";
+    for (const auto& v : kv.second.values)
+      has_time = has_time || v.key == "processing time mean [ms]";
     EXPECT_TRUE(has_time);
   }
 }

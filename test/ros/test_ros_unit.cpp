@@ -4,18 +4,18 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include <dynamic_reconfigure/Config.h>
-#include <opencv2/core.hpp>
 #include <sensor_msgs/image_encodings.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <opencv2/core.hpp>
 
 #include "lidar_stereo_fusion/io/params_yaml.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
@@ -35,7 +35,8 @@ sensor_msgs::ImagePtr makeImage(int width, int height, const std::string& encodi
   msg->height = height;
   msg->encoding = encoding;
   msg->step = width * static_cast<uint32_t>(pixel.size());
-  for (int i = 0; i < width * height; ++i) msg->data.insert(msg->data.end(), pixel.begin(), pixel.end());
+  for (int i = 0; i < width * height; ++i)
+    msg->data.insert(msg->data.end(), pixel.begin(), pixel.end());
   return msg;
 }
 
@@ -73,14 +74,30 @@ void put(uint8_t* p, double v) {
 }
 void putValue(uint8_t* p, uint8_t datatype, double v) {
   switch (datatype) {
-    case PointField::INT8: put<int8_t>(p, v); break;
-    case PointField::UINT8: put<uint8_t>(p, v); break;
-    case PointField::INT16: put<int16_t>(p, v); break;
-    case PointField::UINT16: put<uint16_t>(p, v); break;
-    case PointField::INT32: put<int32_t>(p, v); break;
-    case PointField::UINT32: put<uint32_t>(p, v); break;
-    case PointField::FLOAT32: put<float>(p, v); break;
-    default: put<double>(p, v); break;
+    case PointField::INT8:
+      put<int8_t>(p, v);
+      break;
+    case PointField::UINT8:
+      put<uint8_t>(p, v);
+      break;
+    case PointField::INT16:
+      put<int16_t>(p, v);
+      break;
+    case PointField::UINT16:
+      put<uint16_t>(p, v);
+      break;
+    case PointField::INT32:
+      put<int32_t>(p, v);
+      break;
+    case PointField::UINT32:
+      put<uint32_t>(p, v);
+      break;
+    case PointField::FLOAT32:
+      put<float>(p, v);
+      break;
+    default:
+      put<double>(p, v);
+      break;
   }
 }
 sensor_msgs::PointCloud2 makeCloud(const std::vector<FieldSpec>& fields,
@@ -116,9 +133,10 @@ sensor_msgs::PointCloud2 makeCloud(const std::vector<FieldSpec>& fields,
 // --- images --------------------------------------------------------------------------------------
 TEST(Conversions, EveryEncodingGivesBgrOrGrey) {
   // One pixel colour: blue 10, green 20, red 30.
-  const std::map<std::string, std::vector<uint8_t>> pixels = {
-      {"bgr8", {10, 20, 30}}, {"rgb8", {30, 20, 10}}, {"bgra8", {10, 20, 30, 255}},
-      {"rgba8", {30, 20, 10, 255}}};
+  const std::map<std::string, std::vector<uint8_t>> pixels = {{"bgr8", {10, 20, 30}},
+                                                              {"rgb8", {30, 20, 10}},
+                                                              {"bgra8", {10, 20, 30, 255}},
+                                                              {"rgba8", {30, 20, 10, 255}}};
   for (const auto& kv : pixels) {
     const cv::Mat out = conv::imageToCore(makeImage(4, 3, kv.first, kv.second));
     ASSERT_EQ(out.type(), CV_8UC3) << kv.first;
@@ -199,8 +217,12 @@ TEST(Conversions, VelodyneLayoutWithAnyNumericTypes) {
   for (const uint8_t xyz : {PointField::FLOAT32, PointField::FLOAT64}) {
     for (const uint8_t ring : ring_types) {
       for (const uint8_t time : time_types) {
-        const auto msg = makeCloud({{"x", xyz}, {"y", xyz}, {"z", xyz}, {"intensity", PointField::UINT8},
-                                    {"ring", ring}, {"time", time}},
+        const auto msg = makeCloud({{"x", xyz},
+                                    {"y", xyz},
+                                    {"z", xyz},
+                                    {"intensity", PointField::UINT8},
+                                    {"ring", ring},
+                                    {"time", time}},
                                    {{1.5, -2.25, 0.5, 200, 7, 3}, {10.0, 0.0, -1.0, 3, 0, 0}});
         const conv::CloudConversion out = conv::cloudFromMsg(msg);
         ASSERT_EQ(out.cloud.size(), 2u);
@@ -220,9 +242,12 @@ TEST(Conversions, VelodyneLayoutWithAnyNumericTypes) {
 
 TEST(Conversions, CloudWithoutRingAndWithNaN) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const auto msg = makeCloud({{"x", PointField::FLOAT32}, {"y", PointField::FLOAT32},
-                              {"z", PointField::FLOAT32}, {"laser_id", PointField::UINT16}},
-                             {{1, 2, 3, 5}, {nan, 0, 0, 1}, {0, std::numeric_limits<double>::infinity(), 0, 1}});
+  const auto msg =
+      makeCloud({{"x", PointField::FLOAT32},
+                 {"y", PointField::FLOAT32},
+                 {"z", PointField::FLOAT32},
+                 {"laser_id", PointField::UINT16}},
+                {{1, 2, 3, 5}, {nan, 0, 0, 1}, {0, std::numeric_limits<double>::infinity(), 0, 1}});
   const conv::CloudConversion out = conv::cloudFromMsg(msg);
   EXPECT_FALSE(out.has_ring);
   EXPECT_FALSE(out.has_time);
@@ -233,8 +258,9 @@ TEST(Conversions, CloudWithoutRingAndWithNaN) {
 }
 
 TEST(Conversions, OrganisedCloudWithRowPadding) {
-  auto msg = makeCloud({{"x", PointField::FLOAT32}, {"y", PointField::FLOAT32}, {"z", PointField::FLOAT32}},
-                       {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}, {10, 11, 12}}, 0);
+  auto msg = makeCloud(
+      {{"x", PointField::FLOAT32}, {"y", PointField::FLOAT32}, {"z", PointField::FLOAT32}},
+      {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}, {10, 11, 12}}, 0);
   // Re-lay the 4 points as 2 rows of 2 with 8 bytes of padding at the end of each row.
   sensor_msgs::PointCloud2 organised = msg;
   organised.height = 2;
@@ -255,8 +281,9 @@ TEST(Conversions, MalformedCloudsAreRejectedWithTheReason) {
   EXPECT_NE(conv::checkCloudLayout(no_z).find("'z'"), std::string::npos);
   EXPECT_THROW(conv::cloudFromMsg(no_z), conv::ConversionError);
 
-  auto ok = makeCloud({{"x", PointField::FLOAT32}, {"y", PointField::FLOAT32}, {"z", PointField::FLOAT32}},
-                      {{1, 2, 3}, {4, 5, 6}});
+  auto ok = makeCloud(
+      {{"x", PointField::FLOAT32}, {"y", PointField::FLOAT32}, {"z", PointField::FLOAT32}},
+      {{1, 2, 3}, {4, 5, 6}});
   auto short_data = ok;
   short_data.data.resize(short_data.data.size() - 1);
   EXPECT_FALSE(conv::checkCloudLayout(short_data).empty());
@@ -314,8 +341,8 @@ TEST(Conversions, DepthHasNanWhereEmptyOrTooFar) {
 
 TEST(Conversions, DisparityImageLikeStereoImageProc) {
   cv::Mat1f disparity(10, 20, 0.f);
-  disparity(3, 4) = 0.6f;   // below the search range: widens min_disparity
-  disparity(7, 15) = 250.f; // above: widens max_disparity
+  disparity(3, 4) = 0.6f;    // below the search range: widens min_disparity
+  disparity(7, 15) = 250.f;  // above: widens max_disparity
   lsf::StereoCamera camera;
   camera.fx = 500;
   camera.baseline = 0.3;
@@ -420,6 +447,27 @@ TEST(FrameMatcher, OutOfOrderAndDuplicateStampsAreRejected) {
   EXPECT_FALSE(m.addImages(ros::Time(5.0), 103, now).out_of_order) << "clear() forgets stamps";
 }
 
+TEST(FrameMatcher, LargeStepBackIsARestartNotDisorder) {
+  Matcher m;  // restart_step 1 s
+  const auto now = Clock::now();
+  m.addSweep(ros::Time(20.0), 1, now);
+  m.addImages(ros::Time(20.0), 100, now);
+  m.addImages(ros::Time(20.5), 101, now);            // waits for a later sweep
+  auto ev = m.addImages(ros::Time(10.0), 102, now);  // a bag loop starts again
+  EXPECT_TRUE(ev.restarted);
+  EXPECT_FALSE(ev.out_of_order);
+  EXPECT_EQ(ev.discarded, 1u);
+  ev = m.addSweep(ros::Time(10.04), 2, now);  // stale sweeps are gone: matches
+  ASSERT_EQ(ev.ready.size(), 1u);
+  EXPECT_EQ(ev.ready[0].images, 102);
+  // A sweep from before the restart arriving late pushes the newest stamp up; the next real one
+  // is then again a restart, not out of order.
+  m.addSweep(ros::Time(20.6), 3, now);
+  ev = m.addSweep(ros::Time(10.5), 4, now);
+  EXPECT_TRUE(ev.restarted);
+  EXPECT_FALSE(ev.out_of_order);
+}
+
 TEST(FrameMatcher, TooManyPendingDecidesTheOldest) {
   Matcher::Params p;
   p.max_pending = 2;
@@ -495,7 +543,8 @@ TEST(RosParams, ConfigRoundTripKeepsEveryField) {
   EXPECT_EQ(lsf::ros_params::describeChanges(p, q), "");
   EXPECT_EQ(q.method, lsf::Method::kFusedBF);
   EXPECT_EQ(q.patchmatch.seed, 1234u);
-  EXPECT_NE(lsf::ros_params::describeChanges(lsf::FusionParams(), p).find("patchmatch/window_radius: 5 -> 9"),
+  EXPECT_NE(lsf::ros_params::describeChanges(lsf::FusionParams(), p)
+                .find("patchmatch/window_radius: 5 -> 9"),
             std::string::npos)
       << lsf::ros_params::describeChanges(lsf::FusionParams(), p);
 }
@@ -552,9 +601,10 @@ TEST(RosParams, ShippedYamlHasEveryParameterAndLoadsInTheCore) {
   ASSERT_TRUE(fs.isOpened());
   for (const auto& info : lsf::ros_params::listParams()) {
     const auto slash = info.ros_name.find('/');
-    const cv::FileNode node = slash == std::string::npos
-                                  ? fs[info.ros_name]
-                                  : fs[info.ros_name.substr(0, slash)][info.ros_name.substr(slash + 1)];
+    const cv::FileNode node =
+        slash == std::string::npos
+            ? fs[info.ros_name]
+            : fs[info.ros_name.substr(0, slash)][info.ros_name.substr(slash + 1)];
     EXPECT_FALSE(node.empty()) << info.ros_name << " is missing from config/fusion.yaml";
   }
 }

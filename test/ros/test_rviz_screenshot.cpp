@@ -25,12 +25,12 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <ros/master.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <xmlrpcpp/XmlRpcValue.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "synthetic_input.h"
 
@@ -148,7 +148,7 @@ class Publisher {
     right_info_ = nh_.advertise<sensor_msgs::CameraInfo>("/stereo/right/camera_info", 2);
     cloud_ = nh_.advertise<sensor_msgs::PointCloud2>("/velodyne_points", 2);
     auto tf = lsf::test::lidarToCameraTf(frame.T_cam_lidar, lsf::test::kCameraFrame,
-                                        lsf::test::kLidarFrame);
+                                         lsf::test::kLidarFrame);
     tf.header.stamp = ros::Time::now();
     tf_.sendTransform(tf);
     thread_ = std::thread([this] { loop(); });
@@ -223,8 +223,8 @@ cv::Rect renderView(const cv::Mat3b& image, const cv::Vec3b& colour) {
                                [&](int x) { return cv::countNonZero(is_background.col(x)); });
   if (cols.second == 0) return cv::Rect();
   const cv::Mat1b band = is_background.colRange(cols.first, cols.first + cols.second);
-  const auto rows = longestRun(image.rows, cols.second,
-                               [&](int y) { return cv::countNonZero(band.row(y)); });
+  const auto rows =
+      longestRun(image.rows, cols.second, [&](int y) { return cv::countNonZero(band.row(y)); });
   return cv::Rect(cols.first, rows.first, cols.second, rows.second);
 }
 
@@ -270,15 +270,19 @@ TEST(RvizScreenshot, FusedCloudIsDrawn) {
       "/fusion/points2", 2, [&](const sensor_msgs::PointCloud2ConstPtr&) { ++fused; });
 
   Child rviz({"rviz", "-d", config}, display, out_dir + "/rviz_test_rviz.log");
-  ASSERT_TRUE(waitFor(90.0, [&] { return hasSubscriber("/velodyne_points") &&
-                                         hasSubscriber("/stereo/left/image_rect_color"); }))
+  ASSERT_TRUE(waitFor(90.0,
+                      [&] {
+                        return hasSubscriber("/velodyne_points") &&
+                               hasSubscriber("/stereo/left/image_rect_color");
+                      }))
       << "RViz did not subscribe (see " << out_dir << "/rviz_test_rviz.log)";
   ASSERT_TRUE(rviz.running());
 
   // Phase A: raw LiDAR only; the fusion finds no sweep within max_time_offset.
   ros::WallDuration(8.0).sleep();
   const int fused_in_a = fused;
-  const std::string shot_a = out_dir + "/rviz_phase_a.png", shot_a2 = out_dir + "/rviz_phase_a2.png";
+  const std::string shot_a = out_dir + "/rviz_phase_a.png",
+                    shot_a2 = out_dir + "/rviz_phase_a2.png";
   ASSERT_EQ(run({"import", "-window", "root", shot_a}, display), 0);
   ros::WallDuration(1.5).sleep();
   ASSERT_EQ(run({"import", "-window", "root", shot_a2}, display), 0);

@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/Header.h>
 #include <stereo_msgs/DisparityImage.h>
+#include <opencv2/core.hpp>
 
 #include "lidar_stereo_fusion/core/depth.h"
 #include "lidar_stereo_fusion/core/types.h"
@@ -47,8 +47,9 @@ cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg);
 
 /// Converts a stereo pair; the two results have the same type (mono + colour: both BGR).
 /// Throws ConversionError when either image is unusable or the sizes differ.
-void stereoPairToCore(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right,
-                      cv::Mat& left_out, cv::Mat& right_out);
+void stereoPairToCore(const sensor_msgs::ImageConstPtr& left,
+                      const sensor_msgs::ImageConstPtr& right, cv::Mat& left_out,
+                      cv::Mat& right_out);
 
 /// Rectified stereo camera from the two camera_infos: fx, fy, cx, cy from the left projection
 /// matrix P; baseline B [m] = |Tx_right - Tx_left| / fx with Tx = P[3] (so both sign conventions,

@@ -25,10 +25,14 @@ class FrameMatcher {
   using Clock = std::chrono::steady_clock;
 
   struct Params {
-    double max_time_offset = 0.1;   ///< [s] largest |sweep stamp - image stamp| accepted
-    double max_wait = 0.3;          ///< [s] wall time an image set waits for a later sweep
+    double max_time_offset = 0.1;        ///< [s] largest |sweep stamp - image stamp| accepted
+    double max_wait = 0.3;               ///< [s] wall time an image set waits for a later sweep
     std::size_t sweep_buffer_size = 10;  ///< recent sweeps kept
-    std::size_t max_pending = 4;    ///< image sets waiting at most; the oldest is decided first
+    std::size_t max_pending = 4;  ///< image sets waiting at most; the oldest is decided first
+    /// [s] a stamp this much older than the last one is a restart of time (a bag played with
+    /// --loop, a restarted driver), not disorder: everything buffered is forgotten and the message
+    /// accepted. Smaller steps back are out of order and dropped.
+    double restart_step = 1.0;
   };
 
   struct Match {
@@ -42,6 +46,8 @@ class FrameMatcher {
     std::vector<Match> ready;          ///< matched sets, oldest first
     std::vector<ros::Time> unmatched;  ///< image stamps given up: no sweep within max_time_offset
     bool out_of_order = false;  ///< the message passed in was not newer than the last one (dropped)
+    bool restarted = false;     ///< time restarted (see Params::restart_step): buffers were cleared
+    std::size_t discarded = 0;  ///< image sets still waiting that the restart threw away
   };
 
   explicit FrameMatcher(const Params& params = Params()) : params_(params) {}
@@ -52,8 +58,12 @@ class FrameMatcher {
   Events addImages(const ros::Time& stamp, Images images, Clock::time_point now) {
     Events events;
     if (have_image_ && stamp <= last_image_stamp_) {
-      events.out_of_order = true;
-      return events;
+      if ((last_image_stamp_ - stamp).toSec() <= params_.restart_step) {
+        events.out_of_order = true;
+        return events;
+      }
+      events.restarted = true;
+      events.discarded = clear();
     }
     have_image_ = true;
     last_image_stamp_ = stamp;
@@ -66,11 +76,16 @@ class FrameMatcher {
   Events addSweep(const ros::Time& stamp, Sweep sweep, Clock::time_point now) {
     Events events;
     if (!sweeps_.empty() && stamp <= sweeps_.back().first) {
-      events.out_of_order = true;
-      return events;
+      if ((sweeps_.back().first - stamp).toSec() <= params_.restart_step) {
+        events.out_of_order = true;
+        return events;
+      }
+      events.restarted = true;
+      events.discarded = clear();
     }
     sweeps_.emplace_back(stamp, std::move(sweep));
-    while (sweeps_.size() > std::max<std::size_t>(params_.sweep_buffer_size, 1)) sweeps_.pop_front();
+    while (sweeps_.size() > std::max<std::size_t>(params_.sweep_buffer_size, 1))
+      sweeps_.pop_front();
     resolve(events, now);
     return events;
   }

@@ -6,7 +6,7 @@
 //   out: disparity (stereo_msgs/DisparityImage), depth + depth/camera_info (32FC1 [m], NaN = none),
 //        points2 (PointCloud2 x, y, z, rgb), lidar_disparity (the up-sampled prior, 32FC1 [px],
 //        0 = empty), disparity_image (the disparity as a plain 32FC1 image [px], 0 = none, for
-//        RViz and image_view, which cannot show DisparityImage), stats
+//        RViz's Image display, which cannot show a DisparityImage), stats
 //        (lidar_stereo_fusion/FusionStats), plus /diagnostics.
 // Every output is in the left optical frame and stamped with the left image stamp.
 //
@@ -14,6 +14,11 @@
 // TF, runs the core pipeline on the newest matched set and publishes. A set that is replaced by a
 // newer one before the worker takes it is dropped and counted. Inputs are subscribed only while
 // some output has a subscriber.
+//
+// Bad input never stops the node: every rejected message or skipped frame is counted (FusionStats,
+// diagnostics) and logged at most once per 5 s per topic and problem, naming both. When time
+// restarts (the ROS clock or a stamp jumps back by more than 1 s: a bag played with --loop) the
+// buffers are cleared instead of counting everything as out of order.
 #pragma once
 
 #include <atomic>
@@ -27,8 +32,6 @@
 #include <string>
 #include <thread>
 
-#include <boost/optional.hpp>
-#include <boost/thread/recursive_mutex.hpp>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
 #include <dynamic_reconfigure/server.h>
@@ -44,6 +47,8 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+#include <boost/optional.hpp>
+#include <boost/thread/recursive_mutex.hpp>
 
 #include "lidar_stereo_fusion/FusionConfig.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
