@@ -132,7 +132,7 @@ int run(const Options& o) {
       o.repeat);
   lsf::FusionPipeline pipeline(params);
   pipeline.process(input);  // warm-up: allocations, caches
-  std::vector<lsf::FusionStats> stats;
+  std::vector<lsf::FrameStats> stats;
   UpsamplingDetail detail;
   lsf::ProgressBar progress(std::cerr, o.repeat, false);
   for (int i = 0; i < o.repeat; ++i) {
@@ -141,18 +141,18 @@ int run(const Options& o) {
     if (o.repeat >= 3) progress.update(i + 1, "runs");
   }
 
-  auto medianOf = [&](double lsf::FusionStats::*field) {
+  auto medianOf = [&](double lsf::FrameStats::*field) {
     std::vector<double> v;
     for (const auto& s : stats) v.push_back(s.*field);
     return lsf::median(v);
   };
   std::printf("\n| %-38s | %9s |\n|---|---|\n", "stage (median)", "ms");
   printRow("load frame (PNG + .bin + rings, once)", load_ms);
-  printRow("projection", medianOf(&lsf::FusionStats::projection_ms));
-  printRow("up-sampling", medianOf(&lsf::FusionStats::upsampling_ms));
-  printRow("PatchMatch", medianOf(&lsf::FusionStats::patchmatch_ms));
-  printRow("depth", medianOf(&lsf::FusionStats::depth_ms));
-  printRow("total per frame (pipeline)", medianOf(&lsf::FusionStats::total_ms));
+  printRow("projection", medianOf(&lsf::FrameStats::projection_ms));
+  printRow("up-sampling", medianOf(&lsf::FrameStats::upsampling_ms));
+  printRow("PatchMatch", medianOf(&lsf::FrameStats::patchmatch_ms));
+  printRow("depth", medianOf(&lsf::FrameStats::depth_ms));
+  printRow("total per frame (pipeline)", medianOf(&lsf::FrameStats::total_ms));
   std::printf(
       "\nInside the stages (core functions timed alone, one view):\n\n"
       "| %-38s | %9s |\n|---|---|\n",
@@ -163,7 +163,7 @@ int run(const Options& o) {
   printRow("BI* interpolation (Eq. 3)", lsf::median(detail.interpolation));
   printRow("scan-line search bounds", lsf::median(detail.bounds));
   printRow("BF* bilateral up-sampling", lsf::median(detail.bf));
-  const double total = medianOf(&lsf::FusionStats::total_ms);
+  const double total = medianOf(&lsf::FrameStats::total_ms);
   std::printf("\n%.2f frames/s (pipeline median %.1f ms)\n", 1000.0 / total, total);
   return 0;
 }

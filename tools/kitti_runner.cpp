@@ -155,7 +155,7 @@ int run(const Options& o) {
   lsf::FusionPipeline pipeline(params);
   std::vector<lsf::DepthRow> rows;
   std::vector<lsf::DepthMetrics> scores;
-  std::vector<lsf::FusionStats> stats;
+  std::vector<lsf::FrameStats> stats;
   lsf::ProgressBar progress(std::cerr, static_cast<int>(frames.size()), ::isatty(2) != 0);
   for (size_t i = 0; i < frames.size(); ++i) {
     const lsf::kitti::Frame& frame = frames[i];

@@ -122,7 +122,7 @@ FusionResult FusionPipeline::process(const FusionInput& input) {
   const auto start = Clock::now();
   const Method method = params_.method;
   FusionResult result;
-  FusionStats& stats = result.stats;
+  FrameStats& stats = result.stats;
 
   // Stage 1: projection (left always, for stats and inspection; right only for fused methods).
   auto t = Clock::now();

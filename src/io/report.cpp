@@ -70,27 +70,27 @@ double median(std::vector<double> values) {
   return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-std::string formatTimingSummary(const std::vector<FusionStats>& stats) {
+std::string formatTimingSummary(const std::vector<FrameStats>& stats) {
   struct Stage {
     const char* name;
-    double FusionStats::*field;
+    double FrameStats::*field;
   };
-  const Stage stages[] = {{"projection", &FusionStats::projection_ms},
-                          {"up-sampling", &FusionStats::upsampling_ms},
-                          {"PatchMatch", &FusionStats::patchmatch_ms},
-                          {"depth", &FusionStats::depth_ms},
-                          {"total", &FusionStats::total_ms}};
+  const Stage stages[] = {{"projection", &FrameStats::projection_ms},
+                          {"up-sampling", &FrameStats::upsampling_ms},
+                          {"PatchMatch", &FrameStats::patchmatch_ms},
+                          {"depth", &FrameStats::depth_ms},
+                          {"total", &FrameStats::total_ms}};
   std::string out = row({"stage", "mean ms", "median ms"}) + separator(3);
   for (const Stage& stage : stages) {
     std::vector<double> values;
-    for (const FusionStats& s : stats) values.push_back(s.*(stage.field));
+    for (const FrameStats& s : stats) values.push_back(s.*(stage.field));
     double mean = 0.0;
     for (double v : values) mean += v;
     mean = values.empty() ? 0.0 : mean / values.size();
     out += row({stage.name, format("%.1f", mean), format("%.1f", median(values))});
   }
   double in_front = 0, projected = 0, removed = 0, prior = 0, output = 0;
-  for (const FusionStats& s : stats) {
+  for (const FrameStats& s : stats) {
     in_front += s.points_in_front;
     projected += s.points_projected;
     removed += s.points_removed;

@@ -619,7 +619,7 @@ void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera
   if (pub_stats_.getNumSubscribers() > 0) {
     StatsReport r;
     r.method = methodName(params.method);
-    const FusionStats& s = result.stats;
+    const FrameStats& s = result.stats;
     r.projection_ms = static_cast<float>(s.projection_ms);
     r.upsampling_ms = static_cast<float>(s.upsampling_ms);
     r.patchmatch_ms = static_cast<float>(s.patchmatch_ms);

@@ -154,7 +154,7 @@ TEST(Report, TablesMedianAndProgress) {
   EXPECT_DOUBLE_EQ(median({3, 1, 2}), 2.0);
   EXPECT_DOUBLE_EQ(median({4, 1, 2, 3}), 2.5);
   EXPECT_DOUBLE_EQ(median({}), 0.0);
-  FusionStats a, b, c;
+  FrameStats a, b, c;
   a.patchmatch_ms = 10;
   b.patchmatch_ms = 30;
   c.patchmatch_ms = 200;

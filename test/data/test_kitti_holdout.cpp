@@ -27,7 +27,7 @@ const std::set<std::string> kPmsFrames = {"0000000000", "0000000025", "000000005
 struct MethodScores {
   std::vector<DepthMetrics> all;         ///< every frame the method ran on
   std::vector<DepthMetrics> pms_frames;  ///< the frames plain PMS ran on
-  std::vector<FusionStats> stats;
+  std::vector<FrameStats> stats;
 };
 
 TEST(KittiHoldout, FusedBIBeatsLidarOnlyAndPlainPmsOnTheOddRings) {

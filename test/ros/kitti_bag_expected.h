@@ -1,6 +1,5 @@
-// The core pipeline's depth for one KITTI frame, for test_kitti_bag. In its own translation unit:
-// the generated message lidar_stereo_fusion::FusionStats and the core's struct of the same name
-// cannot be declared together.
+// The core pipeline's depth for one KITTI frame, for test_kitti_bag, in its own translation unit so
+// that the ROS test source does not pull in the core pipeline.
 #pragma once
 
 #include <string>

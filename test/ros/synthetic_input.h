@@ -1,8 +1,7 @@
 // Synthetic inputs of the fusion nodelet for the rostests and the synthetic publisher: frames of
 // the simulated street (sim::generateStreetFrame) as the ROS messages a stereo + LiDAR rig sends.
 //
-// Must not include core/pipeline.h: the test sources that include this also include the generated
-// FusionStats message, which has the same qualified name as the core's struct.
+// Keeps the core pipeline out of the ROS test sources that include it (messages only).
 #pragma once
 
 #include <string>

@@ -38,7 +38,7 @@ struct FusionParams {
 };
 
 /// Per-stage wall time [ms] and counts of one frame.
-struct FusionStats {
+struct FrameStats {
   double projection_ms = 0, upsampling_ms = 0, patchmatch_ms = 0, depth_ms = 0, total_ms = 0;
   int points_in_front = 0;      ///< points in the depth range in front of the camera
   int points_projected = 0;     ///< points landing in the left image
@@ -52,7 +52,7 @@ struct FusionResult {
   cv::Mat1f prior;          ///< stage 2 (left view), 0 = empty
   cv::Mat1f disparity;      ///< final disparity [px], 0 = no value
   cv::Mat1f depth;          ///< final depth [m], 0 = no value
-  FusionStats stats;
+  FrameStats stats;
 };
 
 /// One frame: rectified images (BGR CV_8UC3 or grey), the sweep, and LiDAR -> left optical frame.

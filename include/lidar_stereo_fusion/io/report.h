@@ -33,7 +33,7 @@ double median(std::vector<double> values);
 
 /// Per-stage wall time over frames: mean and median [ms] of projection, up-sampling, PatchMatch,
 /// depth and total, plus the mean point counts and coverages. Markdown.
-std::string formatTimingSummary(const std::vector<FusionStats>& stats);
+std::string formatTimingSummary(const std::vector<FrameStats>& stats);
 
 /// A one-line progress bar ("[=====>    ] 5/11 name  1.2 s/frame"), redrawn in place with '\r'
 /// when `interactive` (a terminal), otherwise one line per update.

@@ -1,9 +1,8 @@
 // Publishing lidar_stereo_fusion/FusionStats (msg/FusionStats.msg).
 //
-// The generated message type lidar_stereo_fusion::FusionStats has the same qualified name as the
-// core's per-frame struct in core/pipeline.h, so no translation unit may include both. This header
-// includes neither: the worker fills a StatsReport (field by field the message) and
-// src/ros/stats_publisher.cpp, which includes only the message, turns it into one.
+// The worker fills a StatsReport (field by field the message) and src/ros/stats_publisher.cpp,
+// which includes only the message, turns it into one, so the worker's sources stay free of the
+// generated message. (The core's per-frame struct is lidar_stereo_fusion::FrameStats.)
 #pragma once
 
 #include <cstdint>
