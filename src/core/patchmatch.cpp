@@ -15,10 +15,14 @@
 //    strips are never written at the same time, so the sweep is race-free; random numbers come
 //    from a counter-based generator keyed by (seed, view, iteration, pixel), so the result does
 //    not depend on the number of threads.
-//  * Per iteration: left view sweep (spatial propagation + refinement), view propagation of the
-//    left planes into the right view, right view sweep, view propagation back into the left.
-//  * Post-processing: left-right check, hole filling with the lower (background) disparity of the
-//    nearest consistent planes left and right, then a colour-weighted median over filled pixels.
+//  * The image's [d_min, d_max] (used where fewer than two scan lines bound a pixel) is the range
+//    of this frame's prior disparities (+ bound_margin) when LiDAR bounds are on.
+//  * Per iteration: left view sweep (spatial propagation + refinement). In the last
+//    `right_iterations` iterations also: view propagation of the left planes into the right view,
+//    right view sweep, view propagation back into the left.
+//  * Post-processing: left-right check (pixels whose match leaves the image are kept), the prior
+//    fills inconsistent pixels where it has a value; elsewhere the lower (background) disparity of
+//    the nearest consistent planes left and right, then a colour-weighted median over those.
 #include "lidar_stereo_fusion/core/patchmatch.h"
 
 #include <omp.h>
