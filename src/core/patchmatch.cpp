@@ -28,7 +28,6 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -395,8 +394,6 @@ class Solver {
     }
   }
 
-  const std::vector<int>& offsets() const { return offsets_; }
-
  private:
   static constexpr int kLutSize = 4096;
   static constexpr float kLutScale = 4.f;        // LUT entries per unit of RGB L1 distance
@@ -554,13 +551,12 @@ void sweep(const Solver& solver, ViewState& v, const PatchMatchParams& p, int it
       const int y0 = strip * strip_rows;
       const int y1 = std::min(v.height, y0 + strip_rows);
       WindowCache cache;
-      Solver local = solver;  // per-thread row cache
       if (forward) {
         for (int y = y0; y < y1; ++y)
-          for (int x = 0; x < v.width; ++x) local.processPixel(x, y, true, iteration, cache);
+          for (int x = 0; x < v.width; ++x) solver.processPixel(x, y, true, iteration, cache);
       } else {
         for (int y = y1 - 1; y >= y0; --y)
-          for (int x = v.width - 1; x >= 0; --x) local.processPixel(x, y, false, iteration, cache);
+          for (int x = v.width - 1; x >= 0; --x) solver.processPixel(x, y, false, iteration, cache);
       }
     }
   }
@@ -573,7 +569,6 @@ void propagateView(const ViewState& src, const Solver& dst_solver, ViewState& ds
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threadCount(p))
   for (int y = 0; y < src.height; ++y) {
     WindowCache cache;
-    Solver local = dst_solver;
     for (int x = 0; x < src.width; ++x) {
       const Plane& plane = src.planes[y * src.width + x];
       const float d = plane.at(static_cast<float>(x), static_cast<float>(y));
@@ -584,11 +579,11 @@ void propagateView(const ViewState& src, const Solver& dst_solver, ViewState& ds
       Plane best = dst.planes[idx];
       float best_cost = dst.cost[idx];
       if (nearlySame(best, moved, static_cast<float>(xq), static_cast<float>(y))) continue;
-      if (!local.admissible(xq, y, moved.at(static_cast<float>(xq), static_cast<float>(y)))) {
+      if (!dst_solver.admissible(xq, y, moved.at(static_cast<float>(xq), static_cast<float>(y)))) {
         continue;
       }
-      local.buildCache(xq, y, cache);
-      local.tryPlane(xq, y, moved, cache, best, best_cost);
+      dst_solver.buildCache(xq, y, cache);
+      dst_solver.tryPlane(xq, y, moved, cache, best, best_cost);
       dst.planes[idx] = best;
       dst.cost[idx] = best_cost;
     }
@@ -743,7 +738,7 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   } else {
     result.inconsistent = cv::Mat1b(size, uchar(0));
   }
-  // Disparities outside the admissible range carry no meaning: mark them empty.
+  // Non-positive or non-finite disparities (holes nothing could fill) are marked empty (0).
   for (float& d : cv::Mat_<float>(result.disparity)) {
     if (!(d > 0.f) || !std::isfinite(d)) d = 0.f;
   }
