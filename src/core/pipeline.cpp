@@ -18,6 +18,7 @@ bool usesLidar(Method m) { return m != Method::kPlainPMS; }
 bool usesPatchMatch(Method m) {
   return m == Method::kFusedBI || m == Method::kFusedBF || m == Method::kPlainPMS;
 }
+bool isFused(Method m) { return m == Method::kFusedBI || m == Method::kFusedBF; }
 bool usesBF(Method m) { return m == Method::kFusedBF || m == Method::kLidarBF; }
 
 double coverage(const cv::Mat1f& m) {
@@ -49,8 +50,11 @@ void checkInput(const FusionInput& in) {
 struct ViewPrior {
   ScanLines lines;
   cv::Mat1f prior;
+  cv::Mat1f confidence;
   ScanLineBounds bounds;
   int removed = 0;
+
+  ViewInput input(const cv::Mat& image) const { return ViewInput{image, prior, bounds, confidence}; }
 };
 
 ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
@@ -121,51 +125,80 @@ FusionResult FusionPipeline::process(const FusionInput& input) {
   checkInput(input);
   const auto start = Clock::now();
   const Method method = params_.method;
-  FusionResult result;
-  FrameStats& stats = result.stats;
 
   // Stage 1: projection (left always, for stats and inspection; right only for fused methods).
-  auto t = Clock::now();
-  result.sparse = projectCloud(input.cloud, input.T_cam_lidar, input.camera, params_.projection,
-                               View::kLeft);
-  stats.points_in_front = result.sparse.points_in_front;
-  stats.points_projected = result.sparse.points_in_image;
-  if (usesLidar(method) && result.sparse.points_in_image == 0) {
+  const auto t = Clock::now();
+  const SparseDisparity left_sparse = projectCloud(input.cloud, input.T_cam_lidar, input.camera,
+                                                   params_.projection, View::kLeft);
+  if (usesLidar(method) && left_sparse.points_in_image == 0) {
     throw std::invalid_argument(
         "no LiDAR points land in the image (" + std::to_string(input.cloud.size()) +
-        " points, " + std::to_string(result.sparse.points_in_front) +
+        " points, " + std::to_string(left_sparse.points_in_front) +
         " in front of the camera): check the cloud and the LiDAR->camera transform");
   }
-  const bool fused = method == Method::kFusedBI || method == Method::kFusedBF;
   SparseDisparity right_sparse;
-  if (fused) {
+  if (isFused(method)) {
     right_sparse = projectCloud(input.cloud, input.T_cam_lidar, input.camera, params_.projection,
                                 View::kRight);
   }
-  stats.projection_ms = msSince(t);
+  const double projection_ms = msSince(t);
+  FusionResult result = runStages(input.left, input.right, left_sparse, right_sparse, input.camera);
+  result.stats.projection_ms = projection_ms;
+  result.stats.total_ms = msSince(start);
+  return result;
+}
 
-  // Stage 2: up-sampling.
-  t = Clock::now();
+FusionResult FusionPipeline::processSparse(const cv::Mat& left, const cv::Mat& right,
+                                           const SparseDisparity& left_sparse,
+                                           const SparseDisparity& right_sparse,
+                                           const StereoCamera& camera) {
+  checkInput(FusionInput{left, right, LidarCloud(), Eigen::Isometry3d::Identity(), camera});
+  const cv::Size size = left.size();
+  if (usesLidar(params_.method) && left_sparse.disparity.size() != size) {
+    throw std::invalid_argument("left sparse disparity size differs from the image size");
+  }
+  if (isFused(params_.method) && right_sparse.disparity.size() != size) {
+    throw std::invalid_argument("right sparse disparity size differs from the image size");
+  }
+  const auto start = Clock::now();
+  FusionResult result = runStages(left, right, left_sparse, right_sparse, camera);
+  result.stats.total_ms = msSince(start);
+  return result;
+}
+
+FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat& right_image,
+                                       const SparseDisparity& left_sparse,
+                                       const SparseDisparity& right_sparse,
+                                       const StereoCamera& camera) {
+  const Method method = params_.method;
+  FusionResult result;
+  FrameStats& stats = result.stats;
+  result.sparse = left_sparse;
+  stats.points_in_front = left_sparse.points_in_front;
+  stats.points_projected = left_sparse.points_in_image;
+  const bool fused = isFused(method);
+
+  // Stage 2: up-sampling (and the prior's confidence).
+  auto t = Clock::now();
   ViewPrior left_prior, right_prior;
   if (usesLidar(method)) {
-    left_prior = upsampleView(result.sparse, input.left, params_);
+    left_prior = upsampleView(left_sparse, left_image, params_);
     stats.points_removed = left_prior.removed;
     result.prior = left_prior.prior;
+    result.confidence = left_prior.confidence;
     stats.prior_coverage = coverage(result.prior);
   }
-  if (fused) right_prior = upsampleView(right_sparse, input.right, params_);
+  if (fused) right_prior = upsampleView(right_sparse, right_image, params_);
   stats.upsampling_ms = msSince(t);
 
   // Stage 3: PatchMatch.
   t = Clock::now();
   if (usesPatchMatch(method)) {
-    ViewInput left{input.left, cv::Mat1f(), ScanLineBounds()};
-    ViewInput right{input.right, cv::Mat1f(), ScanLineBounds()};
+    ViewInput left{left_image, cv::Mat1f(), ScanLineBounds(), cv::Mat1f()};
+    ViewInput right{right_image, cv::Mat1f(), ScanLineBounds(), cv::Mat1f()};
     if (fused) {
-      left.prior = left_prior.prior;
-      left.bounds = left_prior.bounds;
-      right.prior = right_prior.prior;
-      right.bounds = right_prior.bounds;
+      left = left_prior.input(left_image);
+      right = right_prior.input(right_image);
     }
     result.disparity = patchmatch_.compute(left, right).disparity;
   } else {
@@ -175,10 +208,9 @@ FusionResult FusionPipeline::process(const FusionInput& input) {
 
   // Stage 4: depth.
   t = Clock::now();
-  result.depth = disparityToDepth(result.disparity, input.camera, params_.projection.max_depth);
+  result.depth = disparityToDepth(result.disparity, camera, params_.projection.max_depth);
   stats.output_coverage = coverage(result.disparity);
   stats.depth_ms = msSince(t);
-  stats.total_ms = msSince(start);
   return result;
 }
 

@@ -62,8 +62,8 @@ SceneResult runScene(const std::string& name) {
           .disparity;
   PatchMatchStereo plain(FusionParams::plainPmsParams(params.patchmatch));
   const cv::Mat1f pms_disparity = plain
-                                      .compute({scene.left, cv::Mat1f(), ScanLineBounds()},
-                                               {scene.right, cv::Mat1f(), ScanLineBounds()})
+                                      .compute({scene.left, cv::Mat1f(), ScanLineBounds(), cv::Mat1f()},
+                                               {scene.right, cv::Mat1f(), ScanLineBounds(), cv::Mat1f()})
                                       .disparity;
 
   SceneResult result;

@@ -59,6 +59,8 @@ struct ViewInput {
   cv::Mat image;            ///< BGR CV_8UC3 (or grey CV_8UC1) rectified image
   cv::Mat1f prior;          ///< up-sampled LiDAR disparity of this view, 0 = empty (may be empty())
   ScanLineBounds bounds;    ///< search bounds from the scan lines (may be empty())
+  cv::Mat1f confidence;     ///< confidence of the prior in [0, 1] (may be empty(): 1 where the
+                            ///< prior has a value)
 };
 
 /// Runs guided PatchMatch. Scratch buffers (images as float, planes, costs) are reused across

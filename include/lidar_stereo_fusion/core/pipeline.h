@@ -50,6 +50,10 @@ struct FrameStats {
 struct FusionResult {
   SparseDisparity sparse;   ///< stage 1 (left view)
   cv::Mat1f prior;          ///< stage 2 (left view), 0 = empty
+  /// Confidence of the prior (left view), in [0, 1] (unitless): 1 on measured scan-line pixels,
+  /// lower between scan lines that disagree and where Algorithm 1 removed points, 0 where the
+  /// prior is empty. Empty for methods without LiDAR. See PriorConfidenceParams.
+  cv::Mat1f confidence;
   cv::Mat1f disparity;      ///< final disparity [px], 0 = no value
   cv::Mat1f depth;          ///< final depth [m], 0 = no value
   FrameStats stats;
@@ -74,7 +78,19 @@ class FusionPipeline {
   /// Throws std::invalid_argument on bad input (sizes, types, camera) with a message naming it.
   FusionResult process(const FusionInput& input);
 
+  /// Stages 2-4 from sparse disparities already projected into both views (a pseudo-LiDAR made
+  /// from ground truth, or a caller that projects itself). `right_sparse` is used by the fused
+  /// methods only (may be empty otherwise). The camera gives the depth conversion; pass any valid
+  /// camera of the image size when only the disparity is wanted. Same errors as process().
+  FusionResult processSparse(const cv::Mat& left, const cv::Mat& right,
+                             const SparseDisparity& left_sparse,
+                             const SparseDisparity& right_sparse, const StereoCamera& camera);
+
  private:
+  FusionResult runStages(const cv::Mat& left, const cv::Mat& right,
+                         const SparseDisparity& left_sparse, const SparseDisparity& right_sparse,
+                         const StereoCamera& camera);
+
   FusionParams params_;
   PatchMatchStereo patchmatch_;
 };
