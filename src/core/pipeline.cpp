@@ -14,11 +14,11 @@ double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
+bool isFused(Method m) { return m == Method::kFusedBI || m == Method::kFusedBF; }
 bool usesLidar(Method m) { return m != Method::kPlainPMS; }
 bool usesPatchMatch(Method m) {
   return m == Method::kFusedBI || m == Method::kFusedBF || m == Method::kPlainPMS;
 }
-bool isFused(Method m) { return m == Method::kFusedBI || m == Method::kFusedBF; }
 bool usesBF(Method m) { return m == Method::kFusedBF || m == Method::kLidarBF; }
 
 double coverage(const cv::Mat1f& m) {
@@ -60,9 +60,14 @@ struct ViewPrior {
 ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
                        const FusionParams& params) {
   ViewPrior v;
-  v.prior = upsampleBI(sparse, image, params.bi, &v.removed, &v.lines);
+  std::vector<cv::Point> removed;
+  v.prior = upsampleBI(sparse, image, params.bi, &v.removed, &v.lines, &removed);
   if (usesBF(params.method)) v.prior = upsampleBF(sparse, params.bf);
   v.bounds = computeScanLineBounds(v.lines, params.patchmatch.bound_margin);
+  v.confidence = priorConfidence(v.lines, v.prior, removed, params.confidence);
+  if (isFused(params.method) && params.patchmatch.confidence_weighting) {
+    fillPriorHoles(v.prior, v.confidence, params.confidence);
+  }
   return v;
 }
 
@@ -108,6 +113,7 @@ void FusionParams::validate() const {
   projection.validate();
   bi.validate();
   bf.validate();
+  confidence.validate();
   patchmatch.validate();
 }
 

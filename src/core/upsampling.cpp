@@ -6,6 +6,8 @@
 // (fresh full-size buffers cost page faults every frame).
 #include "lidar_stereo_fusion/core/upsampling.h"
 
+#include "column_index.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -16,12 +18,6 @@
 namespace lidar_stereo_fusion {
 
 namespace {
-
-/// One scan-line pixel of a column: row and disparity.
-struct ColumnEntry {
-  int y;
-  float d;
-};
 
 /// A projected point of one ring.
 struct RingPoint {
@@ -47,37 +43,6 @@ void requireValidValues(const cv::Mat1f& map, const char* where) {
     }
   }
 }
-
-/// The non-empty pixels of a map grouped by column, each column top to bottom (CSR layout).
-class ColumnIndex {
- public:
-  explicit ColumnIndex(const cv::Mat1f& map) : begin_(map.cols + 1, 0) {
-    for (int y = 0; y < map.rows; ++y) {
-      const float* row = map[y];
-      for (int x = 0; x < map.cols; ++x) {
-        if (row[x] > 0.f) ++begin_[x + 1];
-      }
-    }
-    for (int x = 0; x < map.cols; ++x) begin_[x + 1] += begin_[x];
-    entries_.resize(begin_[map.cols]);
-    std::vector<int> next(begin_.begin(), begin_.end() - 1);
-    for (int y = 0; y < map.rows; ++y) {
-      const float* row = map[y];
-      for (int x = 0; x < map.cols; ++x) {
-        if (row[x] > 0.f) entries_[next[x]++] = {y, row[x]};
-      }
-    }
-  }
-  int cols() const { return static_cast<int>(begin_.size()) - 1; }
-  /// Number of entries in column x.
-  int size(int x) const { return begin_[x + 1] - begin_[x]; }
-  /// First entry of column x (entries are ordered by row).
-  const ColumnEntry* column(int x) const { return entries_.data() + begin_[x]; }
-
- private:
-  std::vector<int> begin_;
-  std::vector<ColumnEntry> entries_;
-};
 
 /// RGB L1 distance in [0, 765]; for grey images 3 |a - b| (a grey pixel as an RGB triple).
 inline int colorDistance(const cv::Mat& image, int y0, int y1, int x) {
@@ -310,7 +275,8 @@ ScanLines completeScanLines(const SparseDisparity& sparse, const BIParams& param
   return lines;
 }
 
-int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams& params) {
+int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams& params,
+                         std::vector<cv::Point>* removed_pixels) {
   params.validate();
   requireDisparityMap(lines.disparity, "removeOccludedPoints");
   if (image.size() != lines.disparity.size()) {
@@ -343,7 +309,9 @@ int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams&
     lines.disparity(p) = 0.f;
     if (has_ring_map) lines.ring(p) = -1;
   }
-  return static_cast<int>(removed.size());
+  const int count = static_cast<int>(removed.size());
+  if (removed_pixels) *removed_pixels = std::move(removed);
+  return count;
 }
 
 cv::Mat1f interpolateBetweenScanLines(const ScanLines& lines, const BIParams& params) {
@@ -372,9 +340,10 @@ cv::Mat1f interpolateBetweenScanLines(const ScanLines& lines, const BIParams& pa
 }
 
 cv::Mat1f upsampleBI(const SparseDisparity& sparse, const cv::Mat& image, const BIParams& params,
-                     int* removed, ScanLines* lines_out) {
+                     int* removed, ScanLines* lines_out,
+                     std::vector<cv::Point>* removed_pixels) {
   ScanLines lines = completeScanLines(sparse, params);
-  const int count = removeOccludedPoints(lines, image, params);
+  const int count = removeOccludedPoints(lines, image, params, removed_pixels);
   if (removed) *removed = count;
   cv::Mat1f dense = interpolateBetweenScanLines(lines, params);
   if (lines_out) *lines_out = std::move(lines);

@@ -44,6 +44,17 @@ void visitBF(P& p, V& v) {
 }
 
 template <class P, class V>
+void visitConfidence(P& p, V& v) {
+  v("edge_tolerance", p.edge_tolerance);
+  v("edge_sigma", p.edge_sigma);
+  v("max_surface_slope", p.max_surface_slope);
+  v("removed_factor", p.removed_factor);
+  v("near_rows", p.near_rows);
+  v("decay_rows", p.decay_rows);
+  v("hole_confidence", p.hole_confidence);
+}
+
+template <class P, class V>
 void visitPatchMatch(P& p, V& v) {
   v("window_radius", p.window_radius);
   v("window_stride", p.window_stride);
@@ -67,6 +78,9 @@ void visitPatchMatch(P& p, V& v) {
   v("view_propagation", p.view_propagation);
   v("lr_check", p.lr_check);
   v("lr_max_diff", p.lr_max_diff);
+  v("confidence_weighting", p.confidence_weighting);
+  v("lock_confidence", p.lock_confidence);
+  v("fill_confidence", p.fill_confidence);
   v("num_threads", p.num_threads);
   v("seed", p.seed);
 }
@@ -77,6 +91,7 @@ void visitSections(F& params, S& section) {
   section("projection", [&](auto& v) { visitProjection(params.projection, v); });
   section("bi", [&](auto& v) { visitBI(params.bi, v); });
   section("bf", [&](auto& v) { visitBF(params.bf, v); });
+  section("confidence", [&](auto& v) { visitConfidence(params.confidence, v); });
   section("patchmatch", [&](auto& v) { visitPatchMatch(params.patchmatch, v); });
 }
 

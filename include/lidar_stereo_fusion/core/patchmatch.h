@@ -41,7 +41,15 @@ struct PatchMatchParams {
   bool view_propagation = true;
   bool lr_check = true;          ///< left-right consistency + hole filling + weighted median
   double lr_max_diff = 1.0;      ///< [px]
-  int num_threads = 0;           ///< 0 = all cores
+  /// Weight the LiDAR term by the prior's confidence and renormalise the image term where it fades
+  /// (patchmatch/cost.h); false = the paper's cost (gamma everywhere the prior has a value).
+  bool confidence_weighting = true;
+  /// Pixels whose prior confidence is >= this keep the prior's plane and are not searched (the
+  /// LiDAR is sure there; > 1 = search every pixel). Only with confidence_weighting.
+  double lock_confidence = 0.9;
+  /// Inconsistent pixels (left-right check) take the prior where its confidence is >= this.
+  double fill_confidence = 0.5;
+  int num_threads = 0;           ///< 0 = all cores (at most 256)
   uint64_t seed = 42;
   void validate() const;
 };

@@ -9,6 +9,7 @@
 #include "lidar_stereo_fusion/core/depth.h"
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/prior_confidence.h"
 #include "lidar_stereo_fusion/core/upsampling.h"
 
 namespace lidar_stereo_fusion {
@@ -31,6 +32,7 @@ struct FusionParams {
   ProjectionParams projection;
   BIParams bi;
   BFParams bf;
+  PriorConfidenceParams confidence;
   PatchMatchParams patchmatch;
   /// Parameters of the plain-PMS baseline (Bleyer: alpha 0.1, beta 0.9, window 35).
   static PatchMatchParams plainPmsParams(PatchMatchParams base);

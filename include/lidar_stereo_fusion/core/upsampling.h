@@ -4,6 +4,8 @@
 //  BF* (Premebida et al. 2016): bilateral up-sampling, the paper's baseline.
 #pragma once
 
+#include <vector>
+
 #include <opencv2/core.hpp>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
@@ -50,8 +52,10 @@ ScanLines completeScanLines(const SparseDisparity& sparse, const BIParams& param
 /// image (CV_8UC3) or grey (CV_8UC1, distance 3 |a - b| so the threshold means the same). Every
 /// decision is made on the input state (the pixels are cleared after all are decided), so the
 /// result does not depend on scan order. Cleared pixels get disparity 0 and ring -1. Returns the
-/// number removed. Throws std::invalid_argument for an image of another size or type.
-int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams& params);
+/// number removed; `removed_pixels` (optional) receives them (x = column, y = row). Throws
+/// std::invalid_argument for an image of another size or type.
+int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams& params,
+                         std::vector<cv::Point>* removed_pixels = nullptr);
 
 /// BI* step 3 (Eq. 3): linear interpolation in every column between the nearest scan lines above
 /// and below, when they are at most max_interp_rows apart. Pixels on a line keep its value;
@@ -60,9 +64,10 @@ cv::Mat1f interpolateBetweenScanLines(const ScanLines& lines, const BIParams& pa
 
 /// The whole BI* chain. `removed` (optional) receives the Algorithm 1 count; `lines_out`
 /// (optional) the scan lines after Algorithm 1, i.e. the lines Eq. 3 interpolated (the input of
-/// computeScanLineBounds).
+/// computeScanLineBounds); `removed_pixels` (optional) the pixels Algorithm 1 cleared.
 cv::Mat1f upsampleBI(const SparseDisparity& sparse, const cv::Mat& image, const BIParams& params,
-                     int* removed = nullptr, ScanLines* lines_out = nullptr);
+                     int* removed = nullptr, ScanLines* lines_out = nullptr,
+                     std::vector<cv::Point>* removed_pixels = nullptr);
 
 /// BF*: bilateral up-sampling of the sparse disparity (Premebida et al. 2016; no occlusion
 /// handling, as in the paper's comparison). For every pixel p, over the LiDAR points q of the

@@ -1,0 +1,76 @@
+// PatchMatch: the aggregated matching cost C(p, xi) of a plane over the support window
+// (METHOD.md section 3), with the adaptive support weight w and the per-sample cost phi named.
+//
+//   C(p, xi) = sum_{p' in W_p} w(p, p') phi(p', q),   q = p' + s d_xi(p') in the other view
+//   w(p, p') = exp(-|I_p - I_p'|_1 / delta)
+//   rho_img  = alpha min(|I_p' - I_q|_1, lambda_col) + beta min(|grad I_p' - grad I_q|_1, lambda_grad)
+//   rho_lid  = min(|Pi(p') - d_xi(p')|, lambda_disp)
+//
+// Two readings of phi:
+//  * the paper (confidence_weighting = false): phi = rho_img + gamma rho_lid where the prior has a
+//    value, rho_img + gamma lambda_disp where it has none (a constant: it never rewards a plane);
+//  * confidence-weighted (the default): with kappa = gamma c(p'), c the prior's confidence
+//    (prior_confidence.h, 0 without a prior),
+//      phi = (1 - kappa) / (alpha + beta) rho_img + kappa rho_lid.
+//    Where the LiDAR is sure (c = 1) this is the paper's phi; where it fades the image term is
+//    renormalised to full weight, so that with no LiDAR it is plain stereo (Bleyer et al.).
+// A sample whose match falls outside the other image costs the colour/gradient truncations.
+#pragma once
+
+#include <vector>
+
+#include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/plane.h"
+#include "lidar_stereo_fusion/core/patchmatch/view_state.h"
+
+namespace lidar_stereo_fusion {
+namespace patchmatch {
+
+/// The window samples of one pixel in structure-of-arrays form, built once per pixel and shared by
+/// every candidate plane. Arrays are sized once; `count` says how many entries are in use.
+struct WindowCache {
+  std::vector<float> xs, ys;
+  std::vector<float> w_img;    ///< w(p, p') times the image term's factor of phi
+  std::vector<float> w_lidar;  ///< w(p, p') times the LiDAR term's factor of phi (0: no prior)
+  std::vector<float> c0, c1, c2, g0, g1, priors;
+  std::vector<int> row_offset;  ///< start of the sample's row in the other view's colour [floats]
+  float constant = 0.f;         ///< sum of the plane-independent terms (paper: empty prior)
+  int count = 0;
+  void reserve(size_t n);
+};
+
+class MatchingCost {
+ public:
+  MatchingCost(const PatchMatchParams& params, const ViewState& self, const ViewState& other);
+
+  /// w(p, p') for an RGB L1 distance [0, 765].
+  float supportWeight(float l1) const;
+
+  /// The window of pixel (px, py): sample positions, weights, colours, gradients and priors.
+  void buildWindow(int px, int py, WindowCache& cache) const;
+
+  /// C(p, plane) over the cached window. Stops early (returning a value >= bound) once the
+  /// partial sum exceeds `bound`; exact otherwise.
+  float aggregate(const WindowCache& cache, const Plane& plane, float bound) const;
+
+  /// The window offsets used in x and y (multiples of window_stride within window_radius).
+  const std::vector<int>& offsets() const { return offsets_; }
+
+ private:
+  template <bool kGrad>
+  float aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const;
+
+  static constexpr int kLutSize = 4096;
+  static constexpr float kLutScale = 4.f;  ///< LUT entries per unit of RGB L1 distance
+
+  const PatchMatchParams& p_;
+  const ViewState& self_;
+  const ViewState& other_;
+  std::vector<int> offsets_;
+  std::vector<float> weight_lut_;
+  float wa_, wb_, wg_, lcol_, lgrad_, ldisp_, outside_cost_, img_norm_;
+  bool use_grad_, use_prior_, weighted_;
+};
+
+}  // namespace patchmatch
+}  // namespace lidar_stereo_fusion

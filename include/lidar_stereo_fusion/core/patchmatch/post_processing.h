@@ -1,0 +1,33 @@
+// PatchMatch post-processing (Bleyer et al. 2011): left-right consistency check, filling of the
+// inconsistent pixels and a colour-weighted median over the filled ones. Private to the core;
+// exposed for the per-step tests.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "lidar_stereo_fusion/core/patchmatch/view_state.h"
+
+namespace lidar_stereo_fusion {
+namespace patchmatch {
+
+/// Disparity of every pixel's plane at the pixel [px].
+cv::Mat1f disparityOf(const ViewState& v);
+
+/// Left-right check: 255 where the left disparity and the right disparity at its match
+/// (x - round(d)) differ by more than max_diff [px]. A pixel whose match falls outside the right
+/// image (the left border strip) cannot be checked: it is kept (0), or marked 255 when
+/// `unmatched_bad` (the fused method: stereo cannot see there, the LiDAR fill can). Pixels in
+/// `keep` (locked pixels, which the LiDAR measured; may be empty()) are always kept.
+cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float max_diff,
+                         const std::vector<uint8_t>& keep, bool unmatched_bad = false);
+
+/// Fills the pixels marked in `bad` (modified). Where the view's prior has a value and its trust
+/// is >= fill_trust, the prior fills the hole (the LiDAR saw the point: our reading for the fused
+/// method; Bleyer's background fill assumes no other source). Elsewhere the lower (background)
+/// disparity of the nearest consistent planes left and right, then a colour-weighted median over
+/// the window of radius `radius` (every second row and column; weights exp(-L1 colour / delta)).
+void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float fill_trust,
+               cv::Mat1f& disparity, int threads);
+
+}  // namespace patchmatch
+}  // namespace lidar_stereo_fusion

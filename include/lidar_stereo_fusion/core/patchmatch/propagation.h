@@ -1,0 +1,83 @@
+// PatchMatch search steps (METHOD.md section 3): random initialisation, spatial propagation, plane
+// refinement and view propagation, all restricted to the pixel's search range (the scan-line
+// bounds). Private to the core; exposed for the per-step tests.
+//
+// Readings taken here:
+//  * A plane is accepted for pixel p only if its disparity at p lies in [lo(p), hi(p)] from the
+//    scan lines above and below (plus bound_margin), and always in [d_min, d_max] of the image.
+//  * Refinement starts from Delta_d_max = max(|d_up - d_down|, min_refine_range) between scan
+//    lines (else half the image's disparity range), Delta_n_max = 1; both halve until
+//    Delta_d_max < 0.1 px.
+//  * Locked pixels (prior confidence >= lock_confidence) keep the prior's plane: they are not
+//    searched and receive no view propagation, but offer their plane to their neighbours.
+//  * Parallelism: the image is cut into horizontal strips of kStripRows rows processed in two
+//    phases (even strips in parallel, then odd strips), each strip swept in the paper's order.
+//    Adjacent strips are never written at the same time, so the sweep is race-free; random
+//    numbers come from a counter-based generator keyed by (seed, view, iteration, pixel), so the
+//    result does not depend on the number of threads.
+#pragma once
+
+#include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/cost.h"
+#include "lidar_stereo_fusion/core/patchmatch/plane.h"
+#include "lidar_stereo_fusion/core/patchmatch/view_state.h"
+
+namespace lidar_stereo_fusion {
+namespace patchmatch {
+
+class PlaneSearch {
+ public:
+  PlaneSearch(const PatchMatchParams& params, ViewState& self, const ViewState& other);
+
+  const MatchingCost& cost() const { return cost_; }
+
+  /// Whether disparity d at (x, y) is inside the search range of the pixel.
+  bool admissible(int x, int y, float d) const;
+
+  /// Initial plane: the prior's plane where the prior has an admissible value (with
+  /// init_from_prior), else a random disparity in the search range and a random normal (or the
+  /// prior's slope with init_normal_from_prior); front-parallel when !slanted.
+  Plane initialPlane(int x, int y, Rng& rng) const;
+
+  /// One step of a sweep at (x, y): spatial propagation from the left/upper (forward) or
+  /// right/lower neighbour, then plane refinement. Does nothing on a locked pixel.
+  void processPixel(int x, int y, bool forward, int iteration, WindowCache& cache) const;
+
+  /// Replaces (best, best_cost) by `candidate` when it is admissible and cheaper.
+  void tryPlane(int x, int y, const Plane& candidate, const WindowCache& cache, Plane& best,
+                float& best_cost) const;
+
+  /// Plane refinement (random perturbations of d and n, halving ranges).
+  void refine(int x, int y, const WindowCache& cache, Rng& rng, Plane& best,
+              float& best_cost) const;
+
+ private:
+  void initRange(int x, int y, float& lo, float& hi) const;
+  void randomNormal(Rng& rng, float& nx, float& ny, float& nz) const;
+
+  static constexpr float kMinNormalZ = 0.1f;     // rejects planes steeper than ~84 degrees
+  static constexpr float kMinRefineStep = 0.1f;  // paper: stop when Delta_d_max < 0.1
+
+  const PatchMatchParams& p_;
+  ViewState& self_;
+  MatchingCost cost_;
+};
+
+constexpr int kStripRows = 12;
+
+/// Initial planes and their costs of a view (view 0 = left, 1 = right).
+void initialise(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int view);
+
+/// One sweep of spatial propagation + refinement over a view (strips in two phases).
+void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int iteration);
+
+/// View propagation: every pixel of `src` offers its plane, transferred into the other view, to
+/// the pixel it matches in `dst`. Rows are independent, so rows run in parallel.
+void propagateView(const ViewState& src, const PlaneSearch& dst_search, ViewState& dst,
+                   const PatchMatchParams& p, bool left_to_right);
+
+/// Threads to use (num_threads, or all cores for 0).
+int threadCount(const PatchMatchParams& p);
+
+}  // namespace patchmatch
+}  // namespace lidar_stereo_fusion

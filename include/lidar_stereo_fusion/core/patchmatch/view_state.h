@@ -1,0 +1,54 @@
+// PatchMatch: everything the search keeps about one view (images as float, prior, confidence,
+// search bounds, the current plane and cost of every pixel). Private to the core; exposed for the
+// per-step tests.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/plane.h"
+
+namespace lidar_stereo_fusion {
+namespace patchmatch {
+
+struct ViewState {
+  int width = 0, height = 0;
+  float match_sign = -1.f;  ///< the match of x is at x + sign * d in the other view
+  cv::Mat3f color;          ///< BGR float, 0..255
+  cv::Mat2f grad;           ///< (gx, gy) of the grey image (central differences); empty if beta = 0
+  cv::Mat1f prior;          ///< up-sampled LiDAR disparity [px], 0 = empty (may be empty())
+  /// Weight [0, 1] of the prior per pixel: the prior's confidence with confidence_weighting, else
+  /// 1 where the prior has a value (the paper). Empty when there is no prior.
+  cv::Mat1f trust;
+  cv::Mat1f lo, hi, range;  ///< search bounds [px] (empty: unbounded)
+  float d_min = 0.f, d_max = 0.f;  ///< the image's disparity range [px]
+  std::vector<Plane> planes;
+  std::vector<float> cost;
+  /// 1 where the plane is the prior's and is not searched (trust >= lock_confidence).
+  std::vector<uint8_t> locked;
+
+  bool bounded(int x, int y) const { return !lo.empty() && hi(y, x) > 0.f; }
+  bool isLocked(int idx) const { return locked[idx] != 0; }
+};
+
+/// Fills `v` from one view's input (reusing its buffers). match_sign: -1 left, +1 right.
+void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sign, ViewState& v);
+
+/// Throws std::invalid_argument naming the problem when a view's input does not fit `size`.
+void checkViewInput(const ViewInput& v, const cv::Size& size, const char* which);
+
+/// Slope (a, b) of the prior at (x, y) by central differences, when all four neighbours have a
+/// value and |a|, |b| < 1 px/px (a surface, not a depth edge).
+bool priorSlope(const ViewState& v, int x, int y, float& a, float& b);
+
+/// The plane of a locked pixel: the prior's value at (x, y) and its slope per axis from central
+/// differences, one-sided differences where one neighbour has no value (so that the plane of the
+/// last scan line extrapolates the surface beyond it), 0 where none has or where the slope is
+/// 1 px/px or more (a depth edge). Requires prior(y, x) > 0.
+Plane priorPlane(const ViewState& v, int x, int y);
+
+}  // namespace patchmatch
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,155 @@
+// PatchMatch: the aggregated cost C(p, xi), its weight w and per-sample cost phi (see cost.h).
+#include "lidar_stereo_fusion/core/patchmatch/cost.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lidar_stereo_fusion {
+namespace patchmatch {
+
+void WindowCache::reserve(size_t n) {
+  for (auto* v : {&xs, &ys, &w_img, &w_lidar, &c0, &c1, &c2, &g0, &g1, &priors}) v->assign(n, 0.f);
+  row_offset.assign(n, 0);
+}
+
+MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self,
+                           const ViewState& other)
+    : p_(params), self_(self), other_(other) {
+  for (int o = -params.window_radius; o <= params.window_radius; ++o) {
+    if (o % params.window_stride == 0) offsets_.push_back(o);
+  }
+  weight_lut_.resize(kLutSize);
+  for (int i = 0; i < kLutSize; ++i) {
+    weight_lut_[i] = std::exp(-(i / kLutScale) / static_cast<float>(params.weight_delta));
+  }
+  wa_ = static_cast<float>(p_.alpha);
+  wb_ = static_cast<float>(p_.beta);
+  wg_ = static_cast<float>(p_.gamma);
+  lcol_ = static_cast<float>(p_.lambda_col);
+  lgrad_ = static_cast<float>(p_.lambda_grad);
+  ldisp_ = static_cast<float>(p_.lambda_disp);
+  outside_cost_ = wa_ * lcol_ + wb_ * lgrad_;
+  use_grad_ = wb_ > 0.f;
+  use_prior_ = wg_ > 0.f && !self_.prior.empty();
+  weighted_ = p_.confidence_weighting;
+  img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
+}
+
+float MatchingCost::supportWeight(float l1) const {
+  return weight_lut_[std::min(kLutSize - 1, static_cast<int>(l1 * kLutScale))];
+}
+
+void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
+  const size_t n = offsets_.size() * offsets_.size();
+  if (cache.xs.size() < n) cache.reserve(n);
+  cache.constant = 0.f;
+  int k = 0;
+  const cv::Vec3f center = self_.color(py, px);
+  const int color_stride = 3 * other_.width;
+  for (int dy : offsets_) {
+    const int y = py + dy;
+    if (y < 0 || y >= self_.height) continue;
+    const cv::Vec3f* crow = self_.color.ptr<cv::Vec3f>(y);
+    const cv::Vec2f* grow = use_grad_ ? self_.grad.ptr<cv::Vec2f>(y) : nullptr;
+    const float* prow = use_prior_ ? self_.prior.ptr<float>(y) : nullptr;
+    const float* trow = use_prior_ ? self_.trust.ptr<float>(y) : nullptr;
+    for (int dx : offsets_) {
+      const int x = px + dx;
+      if (x < 0 || x >= self_.width) continue;
+      const cv::Vec3f& c = crow[x];
+      const float w = supportWeight(std::abs(c[0] - center[0]) + std::abs(c[1] - center[1]) +
+                                    std::abs(c[2] - center[2]));
+      cache.xs[k] = static_cast<float>(x);
+      cache.ys[k] = static_cast<float>(y);
+      cache.c0[k] = c[0];
+      cache.c1[k] = c[1];
+      cache.c2[k] = c[2];
+      cache.row_offset[k] = y * color_stride;
+      if (use_grad_) {
+        cache.g0[k] = grow[x][0];
+        cache.g1[k] = grow[x][1];
+      }
+      const float trust = use_prior_ ? trow[x] : 0.f;
+      cache.priors[k] = use_prior_ ? prow[x] : 0.f;
+      if (weighted_) {
+        // phi = (1 - kappa) / (alpha + beta) rho_img + kappa rho_lid, kappa = gamma c(p').
+        const float kappa = wg_ * trust;
+        cache.w_img[k] = w * (1.f - kappa) * img_norm_;
+        cache.w_lidar[k] = w * kappa;
+      } else {
+        // The paper: phi = rho_img + gamma rho_lid, or + gamma lambda_disp without a prior.
+        cache.w_img[k] = w;
+        cache.w_lidar[k] = trust > 0.f ? w * wg_ : 0.f;
+        if (use_prior_ && !(trust > 0.f)) cache.constant += w * wg_ * ldisp_;
+      }
+      ++k;
+    }
+  }
+  cache.count = k;
+}
+
+float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, float bound) const {
+  return use_grad_ ? aggregateImpl<true>(cache, plane, bound)
+                   : aggregateImpl<false>(cache, plane, bound);
+}
+
+template <bool kGrad>
+float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane,
+                                  float bound) const {
+  float sum = cache.constant;
+  if (sum >= bound) return sum;
+  const float x_max = static_cast<float>(self_.width - 1);
+  const float x_clamp = x_max - 1e-3f;  // keeps i0 + 1 inside the row
+  const float* other = other_.color.ptr<float>(0);
+  const float* other_grad = kGrad ? other_.grad.ptr<float>(0) : nullptr;
+  const float sign = self_.match_sign;
+  const float a = plane.a, b = plane.b, c = plane.c;
+  const float* xs = cache.xs.data();
+  const float* ys = cache.ys.data();
+  const float* wi = cache.w_img.data();
+  const float* wl = cache.w_lidar.data();
+  const float* c0 = cache.c0.data();
+  const float* c1 = cache.c1.data();
+  const float* c2 = cache.c2.data();
+  const float* g0 = cache.g0.data();
+  const float* g1 = cache.g1.data();
+  const float* pr = cache.priors.data();
+  const int* ro = cache.row_offset.data();
+  // Early exit checked once per window row's worth of samples: most refinement candidates are
+  // worse than the current plane, and the partial sum often exceeds it after a row or two.
+  const int chunk = static_cast<int>(offsets_.size());
+  for (int start = 0; start < cache.count; start += chunk) {
+    const int end = std::min(cache.count, start + chunk);
+    float part = 0.f;
+    for (int k = start; k < end; ++k) {
+      const float d = a * xs[k] + b * ys[k] + c;
+      const float xm_raw = xs[k] + sign * d;
+      const float inside = (xm_raw >= 0.f && xm_raw <= x_max) ? 1.f : 0.f;
+      const float xm = std::min(std::max(xm_raw, 0.f), x_clamp);
+      const int i0 = static_cast<int>(xm);
+      const float f = xm - static_cast<float>(i0);
+      const int idx = ro[k] + 3 * i0;
+      // Colour of q by linear interpolation (sub-pixel match).
+      const float m0 = other[idx] + f * (other[idx + 3] - other[idx]);
+      const float m1 = other[idx + 1] + f * (other[idx + 4] - other[idx + 1]);
+      const float m2 = other[idx + 2] + f * (other[idx + 5] - other[idx + 2]);
+      const float col = std::abs(c0[k] - m0) + std::abs(c1[k] - m1) + std::abs(c2[k] - m2);
+      float rho_img = wa_ * std::min(col, lcol_);
+      if (kGrad) {
+        const int gi = (ro[k] / 3) * 2 + 2 * i0;
+        const float h0 = other_grad[gi] + f * (other_grad[gi + 2] - other_grad[gi]);
+        const float h1 = other_grad[gi + 1] + f * (other_grad[gi + 3] - other_grad[gi + 1]);
+        rho_img += wb_ * std::min(std::abs(g0[k] - h0) + std::abs(g1[k] - h1), lgrad_);
+      }
+      rho_img = inside * rho_img + (1.f - inside) * outside_cost_;
+      const float rho_lid = std::min(std::abs(pr[k] - d), ldisp_);
+      part += wi[k] * rho_img + wl[k] * rho_lid;
+    }
+    sum += part;
+    if (sum >= bound) return sum;
+  }
+  return sum;
+}
+
+}  // namespace patchmatch
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,122 @@
+// LiDAR-guided PatchMatch stereo (Bleyer et al. 2011 + the LiDAR term of Xu et al.): the driver.
+// The steps live in their own files: plane.h (the plane xi), cost.h/.cpp (C, w, phi),
+// propagation.h/.cpp (initialisation, spatial propagation, refinement), view_propagation.cpp,
+// post_processing.h/.cpp (left-right check, filling).
+//
+// Per iteration: left view sweep. In the last `right_iterations` iterations also: view
+// propagation of the left planes into the right view, right view sweep, view propagation back
+// into the left. Then the left-right check and filling.
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
+#include "lidar_stereo_fusion/core/patchmatch/propagation.h"
+
+namespace lidar_stereo_fusion {
+
+namespace {
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw std::invalid_argument("PatchMatchParams: " + message);
+}
+
+}  // namespace
+
+void PatchMatchParams::validate() const {
+  require(window_radius >= 1 && window_radius <= 50, "window_radius must be in [1, 50]");
+  require(window_stride >= 1 && window_stride <= window_radius,
+          "window_stride must be in [1, window_radius]");
+  require(weight_delta > 0, "weight_delta must be > 0");
+  require(alpha >= 0 && beta >= 0 && gamma >= 0, "alpha, beta, gamma must be >= 0");
+  require(std::abs(alpha + beta + gamma - 1.0) < 1e-6, "alpha + beta + gamma must be 1");
+  require(!confidence_weighting || alpha + beta > 0,
+          "confidence_weighting needs an image term (alpha + beta > 0)");
+  require(lambda_col > 0 && lambda_grad > 0 && lambda_disp > 0, "truncations must be > 0");
+  require(iterations >= 0 && iterations <= 100, "iterations must be in [0, 100]");
+  require(right_iterations == -1 || right_iterations >= 1,
+          "right_iterations must be -1 (every iteration) or >= 1");
+  require(bound_margin >= 0, "bound_margin must be >= 0");
+  require(min_refine_range >= 0, "min_refine_range must be >= 0");
+  require(min_disparity > 0, "min_disparity must be > 0");
+  require(max_disparity > min_disparity, "max_disparity must be > min_disparity");
+  require(lr_max_diff > 0, "lr_max_diff must be > 0");
+  require(std::isfinite(lock_confidence) && lock_confidence >= 0,
+          "lock_confidence must be >= 0 (> 1 = never lock)");
+  require(fill_confidence >= 0 && fill_confidence <= 1, "fill_confidence must be in [0, 1]");
+  require(num_threads >= 0 && num_threads <= 256, "num_threads must be in [0, 256] (0 = all cores)");
+}
+
+/// Per-object buffers reused across frames (a fresh full-size buffer costs page faults every frame).
+struct PatchMatchStereo::Scratch {
+  patchmatch::ViewState left, right;
+};
+
+PatchMatchStereo::PatchMatchStereo(const PatchMatchParams& params) { setParams(params); }
+
+void PatchMatchStereo::setParams(const PatchMatchParams& params) {
+  params.validate();
+  params_ = params;
+}
+
+PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInput& right) {
+  using namespace patchmatch;
+  const cv::Size size = left.image.size();
+  checkViewInput(left, size, "left");
+  checkViewInput(right, size, "right");
+  const PatchMatchParams& p = params_;
+  if (!scratch_) scratch_ = std::make_shared<Scratch>();
+  ViewState& lv = scratch_->left;
+  ViewState& rv = scratch_->right;
+  prepareView(left, p, -1.f, lv);
+  prepareView(right, p, +1.f, rv);
+  const bool two_views = p.view_propagation || p.lr_check;
+
+  PlaneSearch left_search(p, lv, rv);
+  PlaneSearch right_search(p, rv, lv);
+  initialise(left_search, lv, p, 0);
+  if (two_views) initialise(right_search, rv, p, 1);
+  // The right view sweeps in the last `right_iterations` iterations only. It serves view
+  // propagation and the left-right check; view propagation runs around its sweeps (left -> right
+  // before, right -> left after), since in the other iterations the right view would only hand
+  // the left view's own planes back.
+  const int right_iterations = p.right_iterations < 0 ? p.iterations
+                                                      : std::min(p.right_iterations, p.iterations);
+  for (int it = 0; it < p.iterations; ++it) {
+    sweep(left_search, lv, p, it);
+    if (!two_views || it < p.iterations - right_iterations) continue;
+    if (p.view_propagation) propagateView(lv, right_search, rv, p, true);
+    sweep(right_search, rv, p, it);
+    if (p.view_propagation) propagateView(rv, left_search, lv, p, false);
+  }
+
+  PatchMatchResult result;
+  result.disparity = disparityOf(lv);
+  result.planes.create(size);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const Plane& pl = lv.planes[y * size.width + x];
+      result.planes(y, x) = cv::Vec3f(pl.a, pl.b, pl.c);
+    }
+  }
+  if (two_views) result.right_disparity = disparityOf(rv);
+  if (p.lr_check) {
+    result.inconsistent = leftRightCheck(result.disparity, result.right_disparity,
+                                         static_cast<float>(p.lr_max_diff), lv.locked,
+                                         p.confidence_weighting && !lv.prior.empty());
+    fillHoles(lv, result.inconsistent.clone(), std::max(p.window_radius, 5),
+              static_cast<float>(p.weight_delta), static_cast<float>(p.fill_confidence),
+              result.disparity, threadCount(p));
+  } else {
+    result.inconsistent = cv::Mat1b(size, uchar(0));
+  }
+  // Non-positive or non-finite disparities (holes nothing could fill) are marked empty (0).
+  for (float& d : cv::Mat_<float>(result.disparity)) {
+    if (!(d > 0.f) || !std::isfinite(d)) d = 0.f;
+  }
+  return result;
+}
+
+}  // namespace lidar_stereo_fusion

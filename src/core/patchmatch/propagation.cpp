@@ -1,0 +1,178 @@
+// PatchMatch search steps: initialisation, spatial propagation, plane refinement (propagation.h).
+#include "lidar_stereo_fusion/core/patchmatch/propagation.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace lidar_stereo_fusion {
+namespace patchmatch {
+
+PlaneSearch::PlaneSearch(const PatchMatchParams& params, ViewState& self, const ViewState& other)
+    : p_(params), self_(self), cost_(params, self, other) {}
+
+bool PlaneSearch::admissible(int x, int y, float d) const {
+  if (!(d >= self_.d_min && d <= self_.d_max)) return false;
+  if (p_.use_lidar_bounds && self_.bounded(x, y)) return d >= self_.lo(y, x) && d <= self_.hi(y, x);
+  return true;
+}
+
+void PlaneSearch::initRange(int x, int y, float& lo, float& hi) const {
+  lo = self_.d_min;
+  hi = self_.d_max;
+  if (p_.use_lidar_bounds && self_.bounded(x, y)) {
+    lo = std::max(lo, self_.lo(y, x));
+    hi = std::min(hi, self_.hi(y, x));
+    if (hi < lo) hi = lo;
+  }
+}
+
+Plane PlaneSearch::initialPlane(int x, int y, Rng& rng) const {
+  if (self_.isLocked(y * self_.width + x)) return priorPlane(self_, x, y);
+  float lo, hi;
+  initRange(x, y, lo, hi);
+  float d = rng.uniform(lo, hi);
+  const float prior = self_.prior.empty() ? 0.f : self_.prior(y, x);
+  if (p_.init_from_prior && prior > 0.f && admissible(x, y, prior)) d = prior;
+  if (!p_.slanted) return Plane{0.f, 0.f, d};
+  float a, b;
+  if (p_.init_from_prior && p_.init_normal_from_prior && prior > 0.f &&
+      priorSlope(self_, x, y, a, b)) {
+    return Plane{a, b, d - a * x - b * y};
+  }
+  float nx, ny, nz;
+  randomNormal(rng, nx, ny, nz);
+  return planeFromNormal(static_cast<float>(x), static_cast<float>(y), d, nx, ny, nz);
+}
+
+void PlaneSearch::randomNormal(Rng& rng, float& nx, float& ny, float& nz) const {
+  // Uniform direction on the hemisphere facing the camera, rejecting near-grazing planes.
+  do {
+    nx = rng.uniform(-1.f, 1.f);
+    ny = rng.uniform(-1.f, 1.f);
+    nz = rng.uniform(-1.f, 1.f);
+    const float norm = std::sqrt(nx * nx + ny * ny + nz * nz);
+    if (norm < 1e-3f || norm > 1.f) {
+      nz = 0.f;
+      continue;
+    }
+    nx /= norm;
+    ny /= norm;
+    nz = std::abs(nz) / norm;
+  } while (nz < kMinNormalZ);
+}
+
+void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
+                               WindowCache& cache) const {
+  const int idx = y * self_.width + x;
+  if (self_.isLocked(idx)) return;
+  cost_.buildWindow(x, y, cache);
+  Plane best = self_.planes[idx];
+  float best_cost = self_.cost[idx];
+  // Spatial propagation: forward sweeps look left/up, backward sweeps right/down.
+  const int step = forward ? -1 : 1;
+  const int nx = x + step, ny = y + step;
+  if (nx >= 0 && nx < self_.width) tryPlane(x, y, self_.planes[idx + step], cache, best, best_cost);
+  if (ny >= 0 && ny < self_.height) {
+    tryPlane(x, y, self_.planes[idx + step * self_.width], cache, best, best_cost);
+  }
+  Rng rng(streamKey(p_.seed, self_.match_sign < 0 ? 0 : 1, iteration, idx));
+  refine(x, y, cache, rng, best, best_cost);
+  self_.planes[idx] = best;
+  self_.cost[idx] = best_cost;
+}
+
+void PlaneSearch::tryPlane(int x, int y, const Plane& candidate, const WindowCache& cache,
+                           Plane& best, float& best_cost) const {
+  // Propagation often offers (nearly) the plane the pixel already has: evaluating it cannot
+  // change the result by more than the tolerance, so skip it.
+  const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+  if (nearlySame(candidate, best, fx, fy)) return;
+  if (!admissible(x, y, candidate.at(fx, fy))) return;
+  const float c = cost_.aggregate(cache, candidate, best_cost);
+  if (c < best_cost) {
+    best = candidate;
+    best_cost = c;
+  }
+}
+
+void PlaneSearch::refine(int x, int y, const WindowCache& cache, Rng& rng, Plane& best,
+                         float& best_cost) const {
+  float dd;
+  if (p_.use_lidar_bounds && self_.bounded(x, y)) {
+    dd = std::max(self_.range(y, x), static_cast<float>(p_.min_refine_range));
+  } else {
+    dd = 0.5f * (self_.d_max - self_.d_min);
+  }
+  float dn = 1.f;
+  const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+  while (dd >= kMinRefineStep) {
+    const float d = best.at(fx, fy) + rng.uniform(-dd, dd);
+    Plane candidate{0.f, 0.f, d};
+    if (p_.slanted) {
+      float nx, ny, nz;
+      normalOf(best, nx, ny, nz);
+      nx += rng.uniform(-dn, dn);
+      ny += rng.uniform(-dn, dn);
+      nz += rng.uniform(-dn, dn);
+      const float norm = std::sqrt(nx * nx + ny * ny + nz * nz);
+      if (norm > 1e-6f && std::abs(nz / norm) >= kMinNormalZ) {
+        candidate = planeFromNormal(fx, fy, d, nx / norm, ny / norm, std::abs(nz) / norm);
+        if (nz < 0.f) candidate = planeFromNormal(fx, fy, d, -nx / norm, -ny / norm, -nz / norm);
+      } else {
+        candidate = Plane{best.a, best.b, d - best.a * fx - best.b * fy};
+      }
+    }
+    tryPlane(x, y, candidate, cache, best, best_cost);
+    dd *= 0.5f;
+    dn *= 0.5f;
+  }
+}
+
+int threadCount(const PatchMatchParams& p) {
+  return p.num_threads > 0 ? p.num_threads : omp_get_num_procs();
+}
+
+void initialise(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int view) {
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threadCount(p))
+  for (int y = 0; y < v.height; ++y) {
+    WindowCache cache;
+    for (int x = 0; x < v.width; ++x) {
+      const int idx = y * v.width + x;
+      Rng rng(streamKey(p.seed, view, -1, idx));
+      v.planes[idx] = search.initialPlane(x, y, rng);
+      if (v.isLocked(idx)) continue;  // never compared: locked pixels are not searched
+      search.cost().buildWindow(x, y, cache);
+      v.cost[idx] = search.cost().aggregate(cache, v.planes[idx], std::numeric_limits<float>::max());
+    }
+  }
+}
+
+void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int iteration) {
+  const bool forward = iteration % 2 == 0;  // iterations 1, 3, ... (0-based even) go forward
+  const int threads = threadCount(p);
+  // The strip layout must not depend on the thread count, or results would.
+  const int strips = (v.height + kStripRows - 1) / kStripRows;
+  for (int phase = 0; phase < 2; ++phase) {
+    const int parity = forward ? phase : 1 - phase;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int s = parity; s < strips; s += 2) {
+      const int strip = forward ? s : strips - 1 - s;
+      const int y0 = strip * kStripRows;
+      const int y1 = std::min(v.height, y0 + kStripRows);
+      WindowCache cache;
+      if (forward) {
+        for (int y = y0; y < y1; ++y)
+          for (int x = 0; x < v.width; ++x) search.processPixel(x, y, true, iteration, cache);
+      } else {
+        for (int y = y1 - 1; y >= y0; --y)
+          for (int x = v.width - 1; x >= 0; --x) search.processPixel(x, y, false, iteration, cache);
+      }
+    }
+  }
+}
+
+}  // namespace patchmatch
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,141 @@
+// Stage 2, last step: the prior's confidence (readings in prior_confidence.h).
+#include "lidar_stereo_fusion/core/prior_confidence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "column_index.h"
+
+namespace lidar_stereo_fusion {
+
+namespace {
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw std::invalid_argument("PriorConfidenceParams: " + message);
+}
+
+/// Slope [px/row] of the line pair (a above b), or NaN when it is steeper than max_slope (the
+/// pair is itself an edge and predicts nothing).
+float pairSlope(const ColumnEntry& a, const ColumnEntry& b, float max_slope) {
+  const float s = (b.d - a.d) / static_cast<float>(b.y - a.y);
+  return std::abs(s) <= max_slope ? s : std::nanf("");
+}
+
+/// Residual r [px] of the interval between lines k and k + 1 of a column (prior_confidence.h).
+float intervalResidual(const ColumnEntry* e, int n, int k, float max_slope) {
+  const ColumnEntry& up = e[k];
+  const ColumnEntry& down = e[k + 1];
+  const float gap = static_cast<float>(down.y - up.y);
+  float r = std::abs(down.d - up.d);
+  if (k >= 1) {
+    const float s = pairSlope(e[k - 1], up, max_slope);
+    if (std::isfinite(s)) r = std::min(r, std::abs(down.d - (up.d + s * gap)));
+  }
+  if (k + 2 < n) {
+    const float s = pairSlope(down, e[k + 2], max_slope);
+    if (std::isfinite(s)) r = std::min(r, std::abs(up.d - (down.d - s * gap)));
+  }
+  return r;
+}
+
+}  // namespace
+
+void PriorConfidenceParams::validate() const {
+  require(std::isfinite(edge_tolerance) && edge_tolerance >= 0, "edge_tolerance must be >= 0");
+  require(std::isfinite(edge_sigma) && edge_sigma > 0, "edge_sigma must be > 0");
+  require(std::isfinite(max_surface_slope) && max_surface_slope >= 0,
+          "max_surface_slope must be >= 0");
+  require(removed_factor >= 0 && removed_factor <= 1, "removed_factor must be in [0, 1]");
+  require(std::isfinite(near_rows) && near_rows >= 0, "near_rows must be >= 0");
+  require(std::isfinite(decay_rows) && decay_rows >= 0, "decay_rows must be >= 0 (0 = off)");
+  require(hole_confidence >= 0 && hole_confidence <= 1, "hole_confidence must be in [0, 1]");
+}
+
+cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
+                          const std::vector<cv::Point>& removed,
+                          const PriorConfidenceParams& params) {
+  params.validate();
+  if (lines.disparity.empty() || prior.empty()) {
+    throw std::invalid_argument("priorConfidence: empty scan lines or prior");
+  }
+  if (lines.disparity.size() != prior.size()) {
+    throw std::invalid_argument("priorConfidence: scan lines and prior differ in size");
+  }
+  const int rows = prior.rows, cols = prior.cols;
+  // Removed pixels by column, each column sorted by row.
+  std::vector<std::vector<int>> removed_rows(cols);
+  for (const cv::Point& p : removed) {
+    if (p.x >= 0 && p.x < cols && p.y >= 0 && p.y < rows) removed_rows[p.x].push_back(p.y);
+  }
+  for (auto& r : removed_rows) std::sort(r.begin(), r.end());
+
+  const float tolerance = static_cast<float>(params.edge_tolerance);
+  const float inv_sigma = static_cast<float>(1.0 / params.edge_sigma);
+  const float max_slope = static_cast<float>(params.max_surface_slope);
+  const float near_rows = static_cast<float>(params.near_rows);
+  const float inv_decay = params.decay_rows > 0 ? static_cast<float>(1.0 / params.decay_rows) : 0.f;
+  const float removed_factor = static_cast<float>(params.removed_factor);
+
+  cv::Mat1f confidence = cv::Mat1f::zeros(prior.size());
+  const ColumnIndex index(lines.disparity);
+  for (int x = 0; x < cols; ++x) {
+    const ColumnEntry* e = index.column(x);
+    const int n = index.size(x);
+    const std::vector<int>& gone = removed_rows[x];
+    for (int k = 0; k < n; ++k) {
+      if (prior(e[k].y, x) > 0.f) confidence(e[k].y, x) = 1.f;
+      if (k + 1 == n) break;
+      const int y_up = e[k].y, y_down = e[k + 1].y;
+      if (y_down - y_up < 2 || !(prior(y_up + 1, x) > 0.f)) continue;  // adjacent, or not bridged
+      const float r = intervalResidual(e, n, k, max_slope);
+      float agree = std::exp(-std::max(0.f, r - tolerance) * inv_sigma);
+      const auto it = std::upper_bound(gone.begin(), gone.end(), y_up);
+      if (it != gone.end() && *it < y_down) agree *= removed_factor;
+      for (int y = y_up + 1; y < y_down; ++y) {
+        const float dist = static_cast<float>(std::min(y - y_up, y_down - y));
+        const float near = std::exp(-std::max(0.f, dist - near_rows) * inv_decay);
+        if (prior(y, x) > 0.f) confidence(y, x) = agree * near;
+      }
+    }
+  }
+  return confidence;
+}
+
+int fillPriorHoles(cv::Mat1f& prior, cv::Mat1f& confidence, const PriorConfidenceParams& params) {
+  params.validate();
+  if (prior.size() != confidence.size()) {
+    throw std::invalid_argument("fillPriorHoles: prior and confidence differ in size");
+  }
+  if (params.hole_confidence <= 0) return 0;
+  const float hole = static_cast<float>(params.hole_confidence);
+  int filled = 0;
+  auto set = [&](int y, int x, float value) {
+    prior(y, x) = value;
+    confidence(y, x) = hole;
+    ++filled;
+  };
+  // Rows: a gap between two values takes the nearer (larger) one; the row ends take the first and
+  // last value.
+  for (int y = 0; y < prior.rows; ++y) {
+    const float* d = prior[y];
+    int last = -1;  // column of the last value seen in this row
+    for (int x = 0; x < prior.cols; ++x) {
+      if (!(d[x] > 0.f)) continue;
+      const float value = last < 0 ? d[x] : std::max(d[last], d[x]);
+      for (int u = last + 1; u < x; ++u) set(y, u, value);
+      last = x;
+    }
+    for (int u = last + 1; last >= 0 && u < prior.cols; ++u) set(y, u, d[last]);
+  }
+  // Columns: below the bottom value, the bottom value (the ground the LiDAR's lowest beam missed).
+  for (int x = 0; x < prior.cols; ++x) {
+    int y = prior.rows - 1;
+    while (y >= 0 && !(prior(y, x) > 0.f)) --y;
+    for (int v = y + 1; y >= 0 && v < prior.rows; ++v) set(v, x, prior(y, x));
+  }
+  return filled;
+}
+
+}  // namespace lidar_stereo_fusion
