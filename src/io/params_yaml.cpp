@@ -81,6 +81,9 @@ void visitPatchMatch(P& p, V& v) {
   v("confidence_weighting", p.confidence_weighting);
   v("lock_confidence", p.lock_confidence);
   v("fill_confidence", p.fill_confidence);
+  v("coarse_scale", p.coarse_scale);
+  v("fine_iterations", p.fine_iterations);
+  v("fine_refine_range", p.fine_refine_range);
   v("num_threads", p.num_threads);
   v("seed", p.seed);
 }

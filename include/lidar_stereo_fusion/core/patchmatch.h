@@ -49,6 +49,12 @@ struct PatchMatchParams {
   double lock_confidence = 0.9;
   /// Inconsistent pixels (left-right check) take the prior where its confidence is >= this.
   double fill_confidence = 0.5;
+  /// Coarse start (patchmatch/coarse_to_fine.h): the search first runs on images reduced by this
+  /// factor (1 = off), then `fine_iterations` sweeps at full size start from its planes, refining
+  /// unbounded pixels from +-fine_refine_range instead of half the image's disparity range.
+  int coarse_scale = 1;
+  int fine_iterations = 1;
+  double fine_refine_range = 2.0;  ///< [px]
   int num_threads = 0;           ///< 0 = all cores (at most 256)
   uint64_t seed = 42;
   void validate() const;
@@ -60,6 +66,7 @@ struct PatchMatchResult {
   cv::Mat1f right_disparity;  ///< right view disparity [px] (when computed)
   cv::Mat1b inconsistent;   ///< 255 where the left-right check failed (then filled)
   cv::Mat3f planes;         ///< per-pixel plane (a, b, c): d = a x + b y + c
+  cv::Mat3f right_planes;   ///< the same for the right view (when computed)
 };
 
 /// Inputs of one view.
@@ -87,6 +94,7 @@ class PatchMatchStereo {
   PatchMatchParams params_;
   struct Scratch;
   std::shared_ptr<Scratch> scratch_;
+  std::shared_ptr<PatchMatchStereo> coarse_;  ///< the coarse start's solver (coarse_scale > 1)
 };
 
 }  // namespace lidar_stereo_fusion

@@ -30,7 +30,12 @@ void PlaneSearch::initRange(int x, int y, float& lo, float& hi) const {
 }
 
 Plane PlaneSearch::initialPlane(int x, int y, Rng& rng) const {
-  if (self_.isLocked(y * self_.width + x)) return priorPlane(self_, x, y);
+  const int idx = y * self_.width + x;
+  if (self_.isLocked(idx)) return priorPlane(self_, x, y);
+  if (!self_.guide.empty()) {
+    const Plane& g = self_.guide[idx];
+    if (admissible(x, y, g.at(static_cast<float>(x), static_cast<float>(y)))) return g;
+  }
   float lo, hi;
   initRange(x, y, lo, hi);
   float d = rng.uniform(lo, hi);
@@ -103,6 +108,8 @@ void PlaneSearch::refine(int x, int y, const WindowCache& cache, Rng& rng, Plane
   float dd;
   if (p_.use_lidar_bounds && self_.bounded(x, y)) {
     dd = std::max(self_.range(y, x), static_cast<float>(p_.min_refine_range));
+  } else if (!self_.guide.empty()) {
+    dd = static_cast<float>(p_.fine_refine_range);  // the coarse start found the neighbourhood
   } else {
     dd = 0.5f * (self_.d_max - self_.d_min);
   }

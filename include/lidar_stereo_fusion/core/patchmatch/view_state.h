@@ -29,6 +29,8 @@ struct ViewState {
   std::vector<float> cost;
   /// 1 where the plane is the prior's and is not searched (trust >= lock_confidence).
   std::vector<uint8_t> locked;
+  /// Planes of the coarse start, up-sampled (empty: none): the initial plane where admissible.
+  std::vector<Plane> guide;
 
   bool bounded(int x, int y) const { return !lo.empty() && hi(y, x) > 0.f; }
   bool isLocked(int idx) const { return locked[idx] != 0; }

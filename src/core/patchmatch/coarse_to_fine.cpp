@@ -1,0 +1,76 @@
+// PatchMatch coarse start (coarse_to_fine.h).
+#include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+namespace lidar_stereo_fusion {
+namespace patchmatch {
+
+namespace {
+
+cv::Size coarseSize(const cv::Size& full, int scale) {
+  return cv::Size(std::max(2, (full.width + scale - 1) / scale),
+                  std::max(1, (full.height + scale - 1) / scale));
+}
+
+/// Nearest-neighbour reduction of a float map, values multiplied by `factor`.
+cv::Mat1f reduceMap(const cv::Mat1f& map, const cv::Size& size, int scale, float factor) {
+  if (map.empty()) return cv::Mat1f();
+  cv::Mat1f out(size);
+  for (int y = 0; y < size.height; ++y) {
+    const float* src = map[std::min(map.rows - 1, y * scale + scale / 2)];
+    float* dst = out[y];
+    for (int x = 0; x < size.width; ++x) dst[x] = src[std::min(map.cols - 1, x * scale + scale / 2)] * factor;
+  }
+  return out;
+}
+
+}  // namespace
+
+ViewInput downsampleView(const ViewInput& in, int scale) {
+  const cv::Size size = coarseSize(in.image.size(), scale);
+  ViewInput out;
+  cv::resize(in.image, out.image, size, 0, 0, cv::INTER_AREA);
+  const float inv = 1.f / static_cast<float>(scale);
+  out.prior = reduceMap(in.prior, size, scale, inv);
+  out.confidence = reduceMap(in.confidence, size, scale, 1.f);
+  out.bounds.lo = reduceMap(in.bounds.lo, size, scale, inv);
+  out.bounds.hi = reduceMap(in.bounds.hi, size, scale, inv);
+  out.bounds.range = reduceMap(in.bounds.range, size, scale, inv);
+  return out;
+}
+
+PatchMatchParams coarseParams(const PatchMatchParams& p) {
+  PatchMatchParams c = p;
+  const int s = p.coarse_scale;
+  c.window_radius = std::max(1, static_cast<int>(std::lround(static_cast<double>(p.window_radius) / s)));
+  c.window_stride = std::min(c.window_radius, std::max(1, p.window_stride / s));
+  c.min_disparity = p.min_disparity / s;
+  c.max_disparity = p.max_disparity / s;
+  c.min_refine_range = p.min_refine_range / s;
+  c.lr_check = false;
+  c.coarse_scale = 1;
+  return c;
+}
+
+std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::Size& full) {
+  std::vector<Plane> planes(static_cast<size_t>(full.area()));
+  const float s = static_cast<float>(scale);
+  // Coarse pixel i covers full pixels i s .. i s + s - 1: x_c = (x - (s - 1) / 2) / s, so
+  // d = s d_c(x_c, y_c) = a x + b y + s c - (a + b) (s - 1) / 2.
+  const float offset = 0.5f * (s - 1.f);
+  for (int y = 0; y < full.height; ++y) {
+    const cv::Vec3f* row = coarse[std::min(coarse.rows - 1, y / scale)];
+    for (int x = 0; x < full.width; ++x) {
+      const cv::Vec3f& q = row[std::min(coarse.cols - 1, x / scale)];
+      planes[static_cast<size_t>(y) * full.width + x] = Plane{q[0], q[1], s * q[2] - offset * (q[0] + q[1])};
+    }
+  }
+  return planes;
+}
+
+}  // namespace patchmatch
+}  // namespace lidar_stereo_fusion
