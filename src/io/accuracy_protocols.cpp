@@ -219,8 +219,8 @@ std::vector<LayoutScores<DisparityMetrics>> runMiddleburyProtocol(const Accuracy
   std::map<std::string, LayoutAccumulator<DisparityMetrics>> acc;
   std::vector<LayoutScores<DisparityMetrics>> out(layouts.size());
   for (const char* scene_name : {"cones", "teddy"}) {
-    const std::string dir = (std::filesystem::path(options.data_dir) / "middlebury" / scene_name)
-                                .string();
+    const std::string dir =
+        (std::filesystem::path(options.data_dir) / "middlebury" / scene_name).string();
     const MiddleburyScene scene = readMiddleburyScene(dir);
     const StereoCamera camera = dummyCamera(scene.left.size());
     if (options.progress) *options.progress << "Middlebury " << scene_name << std::endl;
@@ -231,9 +231,10 @@ std::vector<LayoutScores<DisparityMetrics>> runMiddleburyProtocol(const Accuracy
       if (name != "pms") continue;
       const auto t = Clock::now();
       FusionPipeline pipeline(forMiddlebury(params));
-      pms = pipeline.processSparse(scene.left, scene.right, SparseDisparity(), SparseDisparity(),
-                                   camera)
-                .disparity;
+      pms =
+          pipeline
+              .processSparse(scene.left, scene.right, SparseDisparity(), SparseDisparity(), camera)
+              .disparity;
       pms_seconds = secondsSince(t);
     }
     for (size_t li = 0; li < layouts.size(); ++li) {
@@ -316,11 +317,12 @@ std::vector<LayoutScores<DepthMetrics>> runKittiProtocol(const AccuracyOptions& 
     if (options.progress) *options.progress << "KITTI frame " << frame.name << std::endl;
     const kitti::FrameData data = kitti::loadFrame(frame, camera);
     cv::Mat1f pms;  // no LiDAR: one run serves both layouts
+    double pms_seconds = 0;
     for (size_t li = 0; li < layouts.size(); ++li) {
       LayoutScores<DepthMetrics>& layout = out[li];
-      const HoldoutCase holdout = makeRingHoldout(data.cloud, calib.T_cam_velo, camera,
-                                                  options.fused.projection,
-                                                  kittiKeepEvery(layouts[li]));
+      const HoldoutCase holdout =
+          makeRingHoldout(data.cloud, calib.T_cam_velo, camera, options.fused.projection,
+                          kittiKeepEvery(layouts[li]));
       const FusionInput input{data.left, data.right, holdout.fed, calib.T_cam_velo, camera};
       const SparseDisparity fed = projectCloud(holdout.fed, calib.T_cam_velo, camera,
                                                options.fused.projection, View::kLeft);
@@ -336,14 +338,17 @@ std::vector<LayoutScores<DepthMetrics>> runKittiProtocol(const AccuracyOptions& 
       for (const auto& [name, params] : rows) {
         const bool reuse = name == "pms" && !pms.empty();
         const auto t = Clock::now();
-        if (!reuse) {
+        if (reuse) {
+          depth[name] = pms;
+        } else {
           FusionPipeline pipeline(params);
           depth[name] = pipeline.process(input).depth;
         }
-        const double seconds = reuse ? 0.0 : secondsSince(t);
+        double seconds = secondsSince(t);
         if (name == "pms") {
-          if (reuse) depth[name] = pms;
+          if (!reuse) pms_seconds = seconds;
           pms = depth[name];
+          seconds = pms_seconds;  // the shared run's time, in every layout (as on Middlebury)
         }
         if (wantedRow(options, name)) {
           a.add(name, scoreRegions(depth[name], reference, masks, camera),

@@ -51,11 +51,16 @@ void distanceTransform1d(const std::vector<double>& f, std::vector<double>& d,
 
 std::string regionName(Region region) {
   switch (region) {
-    case Region::kAll: return "all";
-    case Region::kAbove: return "above";
-    case Region::kInside: return "inside";
-    case Region::kEdge: return "edge";
-    case Region::kElsewhere: return "elsewhere";
+    case Region::kAll:
+      return "all";
+    case Region::kAbove:
+      return "above";
+    case Region::kInside:
+      return "inside";
+    case Region::kEdge:
+      return "edge";
+    case Region::kElsewhere:
+      return "elsewhere";
   }
   return "unknown";
 }
@@ -63,11 +68,16 @@ std::string regionName(Region region) {
 const cv::Mat1b& RegionMasks::mask(Region region) const {
   static const cv::Mat1b none;
   switch (region) {
-    case Region::kAbove: return above;
-    case Region::kInside: return inside;
-    case Region::kEdge: return edge;
-    case Region::kElsewhere: return elsewhere;
-    case Region::kAll: break;
+    case Region::kAbove:
+      return above;
+    case Region::kInside:
+      return inside;
+    case Region::kEdge:
+      return edge;
+    case Region::kElsewhere:
+      return elsewhere;
+    case Region::kAll:
+      break;
   }
   return none;
 }

@@ -68,7 +68,7 @@ SparseDisparity twoLines(float upper, float lower) {
 
 TEST(RegionMasks, AboveInsideEdgeAndElsewhere) {
   SparseDisparity s = twoLines(10.f, 20.f);  // |20 - 10| > 3: the rows between are "edge"
-  s.disparity(2, 0) = 0.f;                    // column 0's topmost fed pixel is then on row 6
+  s.disparity(2, 0) = 0.f;                   // column 0's topmost fed pixel is then on row 6
   s.ring(2, 0) = -1;
   const cv::Mat image(9, 4, CV_8UC1, cv::Scalar(0));
   const RegionMasks m = computeRegionMasks(s, image);
@@ -106,8 +106,8 @@ TEST(AccuracyLayouts, MiddleburyRowsAndKittiKeepEvery) {
   EXPECT_EQ(cv::countNonZero(middleburyLayout(gt, "mb64").disparity), 64 * 5);
   const SparseDisparity low = middleburyLayout(gt, "mb42low");
   EXPECT_EQ(cv::countNonZero(low.disparity.rowRange(0, 30)), 0);  // 90 / 3 = 30
-  EXPECT_EQ(cv::countNonZero(low.disparity.row(30)), 5);           // 30 + floor(0.5 * 60 / 42)
-  EXPECT_EQ(cv::countNonZero(low.disparity.row(89)), 5);           // 30 + floor(41.5 * 60 / 42)
+  EXPECT_EQ(cv::countNonZero(low.disparity.row(30)), 5);          // 30 + floor(0.5 * 60 / 42)
+  EXPECT_EQ(cv::countNonZero(low.disparity.row(89)), 5);          // 30 + floor(41.5 * 60 / 42)
   EXPECT_EQ(kittiKeepEvery("ring32"), 2);
   EXPECT_EQ(kittiKeepEvery("ring16"), 4);
   EXPECT_THROW(middleburyLayout(gt, "mb8"), std::invalid_argument);

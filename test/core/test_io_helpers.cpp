@@ -57,9 +57,9 @@ TEST(RingHoldout, KeepEveryFourFeedsRingsZeroFourEightAndRejectsKeepEveryBelowTw
   for (const LidarPoint& p : split.held_out) EXPECT_NE(p.ring % 4, 0) << p.ring;
   EXPECT_THROW(splitRings(cloud, 1), std::invalid_argument);
   // The hold-out with keep_every 4 scores on rings 1-3: a point of ring 3 is the reference.
-  const HoldoutCase holdout = makeRingHoldout({point(0, 0, 10, 0), point(0, 0, 5, 3)},
-                                              Eigen::Isometry3d::Identity(), camera(),
-                                              ProjectionParams(), 4);
+  const HoldoutCase holdout =
+      makeRingHoldout({point(0, 0, 10, 0), point(0, 0, 5, 3)}, Eigen::Isometry3d::Identity(),
+                      camera(), ProjectionParams(), 4);
   ASSERT_EQ(holdout.fed.size(), 1u);
   EXPECT_EQ(holdout.reference_depth(5, 10), 5.f);
   EXPECT_THROW(makeRingHoldout({point(0, 0, 10, 0), point(0, 0, 5, 4)},

@@ -9,9 +9,9 @@
 //    "ring16" rings with ring % 4 == 0; all other rings' points are the reference depth. Scored
 //    with evaluateDepth; mean over frames (averageMetrics).
 //
-// Scoring rule for every method: empty pixels are first filled by fillLikeDevkit (the KITTI devkit's
-// interpolateBackground), as the KITTI benchmark does; "raw coverage" reports the fraction of
-// reference pixels the method covered before that fill.
+// Scoring rule for every method: empty pixels are first filled by fillLikeDevkit (the KITTI
+// devkit's interpolateBackground), as the KITTI benchmark does; "raw coverage" reports the fraction
+// of reference pixels the method covered before that fill.
 //
 // Methods (rows): "fused" (FusionParams() defaults), "paper" (the preset, when given), "lidar_bi",
 // "lidar_bf", "pms" (all through FusionPipeline), "lidar_bi else pms" (lidar_bi where it has a
@@ -79,18 +79,20 @@ using RegionScores = std::array<Metrics, kRegionCount>;
 
 template <typename Metrics>
 struct MethodScores {
-  std::string name;                              ///< "fused", "lidar_bi", ...
-  std::vector<RegionScores<Metrics>> per_item;   ///< one per scene / frame (LayoutScores::items)
-  RegionScores<Metrics> mean;                    ///< averageMetrics over the items, per region
+  std::string name;                             ///< "fused", "lidar_bi", ...
+  std::vector<RegionScores<Metrics>> per_item;  ///< one per scene / frame (LayoutScores::items)
+  RegionScores<Metrics> mean;                   ///< averageMetrics over the items, per region
   double raw_coverage = 0;  ///< mean fraction of reference pixels covered before the fill
-  double seconds = 0;       ///< wall time of the method over all items [s]
+  /// Wall time of the method over all items [s]. pms uses no LiDAR: it runs once per scene /
+  /// frame and that run's time is reported in every layout.
+  double seconds = 0;
 };
 
 /// One layout (a pseudo-LiDAR of a given density, a ring subset) of one protocol.
 template <typename Metrics>
 struct LayoutScores {
-  std::string name;         ///< "mb64", "mb16", "mb42low", "ring32", "ring16"
-  std::string description;  ///< one line for the table title
+  std::string name;                ///< "mb64", "mb16", "mb42low", "ring32", "ring16"
+  std::string description;         ///< one line for the table title
   std::vector<std::string> items;  ///< scene or frame names
   std::vector<MethodScores<Metrics>> methods;
   std::vector<int> fed_rings;  ///< distinct rings fed, per item
@@ -106,15 +108,15 @@ struct LayoutScores {
 
 /// What to run.
 struct AccuracyOptions {
-  std::string data_dir;                ///< the folder of ../shared/data
-  FusionParams fused;                  ///< the "fused" row (and the base of lidar_*, pms)
-  std::optional<FusionParams> paper;   ///< the "paper" row; absent: the row is skipped
+  std::string data_dir;               ///< the folder of ../shared/data
+  FusionParams fused;                 ///< the "fused" row (and the base of lidar_*, pms)
+  std::optional<FusionParams> paper;  ///< the "paper" row; absent: the row is skipped
   /// Method rows to run (names as above); empty = all. "lidar_bi else pms" needs both parts.
   std::set<std::string> methods;
-  std::set<std::string> layouts;       ///< layout names to run; empty = all
-  int kitti_frames = 0;                ///< the first N frames; 0 = all
-  bool kitti_pms = true;               ///< false: skip pms and "lidar_bi else pms" on KITTI
-  std::ostream* progress = nullptr;    ///< one line per scene / frame when set
+  std::set<std::string> layouts;     ///< layout names to run; empty = all
+  int kitti_frames = 0;              ///< the first N frames; 0 = all
+  bool kitti_pms = true;             ///< false: skip pms and "lidar_bi else pms" on KITTI
+  std::ostream* progress = nullptr;  ///< one line per scene / frame when set
   /// Throws std::invalid_argument for an unknown method / layout name or kitti_frames < 0.
   void validate() const;
 };

@@ -1,10 +1,10 @@
 // Ring hold-out: feed some LiDAR rings to the method and score it on the others. ROS-free.
 //
 // KITTI has no ground truth for the raw drive in ../shared/data, so accuracy is checked by feeding
-// some rings only (the even ones, or every 4th) and using the other rings' points, projected into the left image, as the
-// reference depth. The reference shares the LiDAR's own errors and includes a few points the camera
-// cannot see (LiDAR-camera parallax); it is a consistency check, not KITTI's accumulated ground
-// truth.
+// some rings only (the even ones, or every 4th) and using the other rings' points, projected into
+// the left image, as the reference depth. The reference shares the LiDAR's own errors and includes
+// a few points the camera cannot see (LiDAR-camera parallax); it is a consistency check, not
+// KITTI's accumulated ground truth.
 #pragma once
 
 #include <Eigen/Geometry>
