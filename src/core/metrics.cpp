@@ -1,6 +1,7 @@
 // KITTI depth-completion metrics (devkit conventions) and disparity bad-pixel rates.
 #include "lidar_stereo_fusion/core/metrics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -110,6 +111,54 @@ DisparityMetrics evaluateDisparity(const cv::Mat1f& disparity, const cv::Mat1f& 
   m.bad5 = bad5 / n;
   m.coverage = covered / n;
   return m;
+}
+
+// Follows the loops of KITTI devkit_depth cpp/io_depth.h, DepthImage::interpolateBackground()
+// (Andreas Geiger; identical structure in the stereo devkit's io_disp.h): row gaps with u1 > 0 and
+// u2 < width - 1 take std::min(depth left, depth right), then left/right extrapolation per row,
+// then top/bottom extrapolation per column. "Valid" there is >= 0 with -1 for missing; here > 0.
+cv::Mat1f fillLikeDevkit(const cv::Mat1f& map, MapKind kind) {
+  cv::Mat1f out(map.size(), 0.f);
+  for (int y = 0; y < map.rows; ++y) {
+    for (int x = 0; x < map.cols; ++x) out(y, x) = hasValue(map(y, x)) ? map(y, x) : 0.f;
+  }
+  const auto nearer = [kind](float a, float b) {
+    return kind == MapKind::kDepth ? std::min(a, b) : std::max(a, b);
+  };
+  const int w = out.cols, h = out.rows;
+  for (int y = 0; y < h; ++y) {
+    float* row = out[y];
+    int count = 0;  // empty pixels since the last estimate
+    for (int x = 0; x < w; ++x) {
+      if (row[x] <= 0.f) {
+        ++count;
+        continue;
+      }
+      const int u1 = x - count, u2 = x - 1;
+      if (count >= 1 && u1 > 0 && u2 < w - 1) {
+        const float value = nearer(row[u1 - 1], row[u2 + 1]);
+        for (int u = u1; u <= u2; ++u) row[u] = value;
+      }
+      count = 0;
+    }
+    int first = 0;
+    while (first < w && row[first] <= 0.f) ++first;
+    if (first == w) continue;  // no estimate in this row
+    for (int x = 0; x < first; ++x) row[x] = row[first];
+    int last = w - 1;
+    while (row[last] <= 0.f) --last;
+    for (int x = last + 1; x < w; ++x) row[x] = row[last];
+  }
+  for (int x = 0; x < w; ++x) {
+    int first = 0;
+    while (first < h && out(first, x) <= 0.f) ++first;
+    if (first == h) continue;
+    for (int y = 0; y < first; ++y) out(y, x) = out(first, x);
+    int last = h - 1;
+    while (out(last, x) <= 0.f) --last;
+    for (int y = last + 1; y < h; ++y) out(y, x) = out(last, x);
+  }
+  return out;
 }
 
 DepthMetrics averageMetrics(const std::vector<DepthMetrics>& per_image) {

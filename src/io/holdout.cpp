@@ -1,4 +1,4 @@
-// Ring hold-out: even rings in, odd rings as the reference depth.
+// Ring hold-out: every keep_every-th ring in, the other rings as the reference depth.
 #include "lidar_stereo_fusion/io/holdout.h"
 
 #include <cmath>
@@ -7,18 +7,24 @@
 
 namespace lidar_stereo_fusion {
 
-RingSplit splitRingsEvenOdd(const LidarCloud& cloud) {
+RingSplit splitRings(const LidarCloud& cloud, int keep_every) {
+  if (keep_every < 2) {
+    throw std::invalid_argument("splitRings: keep_every must be >= 2, got " +
+                                std::to_string(keep_every));
+  }
   RingSplit split;
   for (size_t i = 0; i < cloud.size(); ++i) {
     const LidarPoint& p = cloud[i];
     if (p.ring < 0) {
-      throw std::invalid_argument("splitRingsEvenOdd: point " + std::to_string(i) +
+      throw std::invalid_argument("splitRings: point " + std::to_string(i) +
                                   " has no ring; recover rings first");
     }
-    (p.ring % 2 == 0 ? split.fed : split.held_out).push_back(p);
+    (p.ring % keep_every == 0 ? split.fed : split.held_out).push_back(p);
   }
   return split;
 }
+
+RingSplit splitRingsEvenOdd(const LidarCloud& cloud) { return splitRings(cloud, 2); }
 
 cv::Mat1f projectReferenceDepth(const LidarCloud& held_out, const Eigen::Isometry3d& T_cam_lidar,
                                 const StereoCamera& camera, const ProjectionParams& params) {
@@ -39,12 +45,14 @@ cv::Mat1f projectReferenceDepth(const LidarCloud& held_out, const Eigen::Isometr
 }
 
 HoldoutCase makeRingHoldout(const LidarCloud& cloud, const Eigen::Isometry3d& T_cam_lidar,
-                            const StereoCamera& camera, const ProjectionParams& params) {
-  RingSplit split = splitRingsEvenOdd(cloud);
+                            const StereoCamera& camera, const ProjectionParams& params,
+                            int keep_every) {
+  RingSplit split = splitRings(cloud, keep_every);
   HoldoutCase holdout;
   holdout.reference_depth = projectReferenceDepth(split.held_out, T_cam_lidar, camera, params);
   if (cv::countNonZero(holdout.reference_depth) == 0) {
-    throw std::invalid_argument("makeRingHoldout: no held-out (odd-ring) point lands in the image");
+    throw std::invalid_argument("makeRingHoldout: no held-out point (ring % " +
+                                std::to_string(keep_every) + " != 0) lands in the image");
   }
   holdout.fed = std::move(split.fed);
   return holdout;

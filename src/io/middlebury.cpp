@@ -41,17 +41,27 @@ MiddleburyScene readMiddleburyScene(const std::string& dir, double disparity_sca
   return scene;
 }
 
-SparseDisparity sampleRowsAsScanLines(const cv::Mat1f& disparity, int num_rows) {
-  if (num_rows < 2 || num_rows > disparity.rows) {
+int scanLineRow(int ring, int num_rows, int image_rows, int first_row) {
+  return first_row +
+         static_cast<int>(std::floor((ring + 0.5) * (image_rows - first_row) / num_rows));
+}
+
+SparseDisparity sampleRowsAsScanLines(const cv::Mat1f& disparity, int num_rows, int first_row) {
+  if (first_row < 0 || (first_row > 0 && first_row > disparity.rows - 2)) {
+    throw std::invalid_argument("sampleRowsAsScanLines: first_row must be in [0, rows - 2 = " +
+                                std::to_string(disparity.rows - 2) + "], got " +
+                                std::to_string(first_row));
+  }
+  const int rows = disparity.rows - first_row;
+  if (num_rows < 2 || num_rows > rows) {
     throw std::invalid_argument("sampleRowsAsScanLines: num_rows must be in [2, " +
-                                std::to_string(disparity.rows) + "], got " +
-                                std::to_string(num_rows));
+                                std::to_string(rows) + "], got " + std::to_string(num_rows));
   }
   SparseDisparity sparse;
   sparse.disparity = cv::Mat1f(disparity.size(), 0.f);
   sparse.ring = cv::Mat1s(disparity.size(), static_cast<int16_t>(-1));
   for (int ring = 0; ring < num_rows; ++ring) {
-    const int y = static_cast<int>(std::floor((ring + 0.5) * disparity.rows / num_rows));
+    const int y = scanLineRow(ring, num_rows, disparity.rows, first_row);
     for (int x = 0; x < disparity.cols; ++x) {
       const float d = disparity(y, x);
       if (!(std::isfinite(d) && d > 0.f)) continue;

@@ -45,6 +45,28 @@ TEST(RingHoldout, SplitsByRingParityAndRejectsPointsWithoutRing) {
   EXPECT_THROW(splitRingsEvenOdd({point(0, 0, 1, -1)}), std::invalid_argument);
 }
 
+TEST(RingHoldout, KeepEveryFourFeedsRingsZeroFourEightAndRejectsKeepEveryBelowTwo) {
+  LidarCloud cloud;
+  for (int ring = 0; ring < 12; ++ring) cloud.push_back(point(0, 0, 1.f + ring, ring));
+  const RingSplit split = splitRings(cloud, 4);
+  ASSERT_EQ(split.fed.size(), 3u);
+  EXPECT_EQ(split.fed[0].ring, 0);
+  EXPECT_EQ(split.fed[1].ring, 4);
+  EXPECT_EQ(split.fed[2].ring, 8);
+  EXPECT_EQ(split.held_out.size(), 9u);
+  for (const LidarPoint& p : split.held_out) EXPECT_NE(p.ring % 4, 0) << p.ring;
+  EXPECT_THROW(splitRings(cloud, 1), std::invalid_argument);
+  // The hold-out with keep_every 4 scores on rings 1-3: a point of ring 3 is the reference.
+  const HoldoutCase holdout =
+      makeRingHoldout({point(0, 0, 10, 0), point(0, 0, 5, 3)}, Eigen::Isometry3d::Identity(),
+                      camera(), ProjectionParams(), 4);
+  ASSERT_EQ(holdout.fed.size(), 1u);
+  EXPECT_EQ(holdout.reference_depth(5, 10), 5.f);
+  EXPECT_THROW(makeRingHoldout({point(0, 0, 10, 0), point(0, 0, 5, 4)},
+                               Eigen::Isometry3d::Identity(), camera(), ProjectionParams(), 4),
+               std::invalid_argument);  // ring 4 is fed: no reference left
+}
+
 TEST(RingHoldout, ReferenceDepthIsTheNearestZPerRoundedPixel) {
   // Identity transform: the LiDAR frame is the camera frame.
   const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
@@ -91,6 +113,25 @@ TEST(PseudoLidar, EvenlySpacedRowsWithRingIdsAndOnlyKnownDisparities) {
   EXPECT_EQ(sparse.points_in_image, 19);
   EXPECT_THROW(sampleRowsAsScanLines(gt, 1), std::invalid_argument);
   EXPECT_THROW(sampleRowsAsScanLines(gt, 9), std::invalid_argument);
+}
+
+TEST(PseudoLidar, FirstRowSpreadsTheRowsOverTheLowerPartOnly) {
+  // 12 rows, first row 4: rows 4 + floor((k + 0.5) * 8 / 4) = 5, 7, 9, 11.
+  const cv::Mat1f gt(12, 3, 2.f);
+  const SparseDisparity sparse = sampleRowsAsScanLines(gt, 4, 4);
+  for (int y = 0; y < 12; ++y) {
+    const bool sampled = y == 5 || y == 7 || y == 9 || y == 11;
+    EXPECT_EQ(cv::countNonZero(sparse.disparity.row(y)), sampled ? 3 : 0) << y;
+    if (sampled) EXPECT_EQ(sparse.ring(y, 0), (y - 5) / 2) << y;
+  }
+  EXPECT_EQ(scanLineRow(0, 4, 12, 4), 5);
+  EXPECT_EQ(scanLineRow(3, 4, 12, 4), 11);
+  EXPECT_EQ(scanLineRow(1, 3, 10, 0), 5);  // floor(1.5 * 10 / 3)
+  // Default first row 0 keeps the old layout.
+  EXPECT_EQ(cv::countNonZero(sampleRowsAsScanLines(gt, 4).disparity.row(1)), 3);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 4, -1), std::invalid_argument);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 2, 11), std::invalid_argument);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 9, 4), std::invalid_argument);  // 8 rows below row 4
 }
 
 TEST(PseudoLidar, RightViewShiftsByTheRoundedDisparityAndTheNearerSampleWins) {

@@ -140,5 +140,49 @@ TEST(AverageMetrics, EveryImageWeighsTheSameAndEmptyImagesAreSkipped) {
   EXPECT_EQ(dm.count, 8);
 }
 
+// fillLikeDevkit: the loops of the KITTI devkit's interpolateBackground (io_depth.h).
+TEST(FillLikeDevkit, RowGapTakesTheNearerValueAndRowEndsAreExtended) {
+  const cv::Mat1f depth = (cv::Mat1f(1, 7) << 0, 5, 0, 0, 9, 0, 0);
+  const cv::Mat1f filled = fillLikeDevkit(depth, MapKind::kDepth);
+  const cv::Mat1f expected = (cv::Mat1f(1, 7) << 5, 5, 5, 5, 9, 9, 9);  // min depth = nearer
+  EXPECT_EQ(cv::countNonZero(filled != expected), 0) << filled;
+
+  const cv::Mat1f disparity = (cv::Mat1f(1, 7) << 0, 5, 0, 0, 9, 0, 0);
+  const cv::Mat1f filled_d = fillLikeDevkit(disparity, MapKind::kDisparity);
+  const cv::Mat1f expected_d = (cv::Mat1f(1, 7) << 5, 5, 9, 9, 9, 9, 9);  // max disparity
+  EXPECT_EQ(cv::countNonZero(filled_d != expected_d), 0) << filled_d;
+}
+
+TEST(FillLikeDevkit, ColumnsAreExtendedUpAndDownButAnEmptyMiddleRowStaysEmpty) {
+  // Rows 0, 2 and 4 are empty; rows 1 and 3 have one estimate each.
+  cv::Mat1f depth(5, 3, 0.f);
+  depth(1, 1) = 4.f;
+  depth(3, 0) = 7.f;
+  const cv::Mat1f filled = fillLikeDevkit(depth, MapKind::kDepth);
+  const cv::Mat1f expected = (cv::Mat1f(5, 3) << 4, 4, 4,  //
+                              4, 4, 4,                     //
+                              0, 0, 0,                     // between two filled rows: as devkit
+                              7, 7, 7,                     //
+                              7, 7, 7);
+  EXPECT_EQ(cv::countNonZero(filled != expected), 0) << filled;
+}
+
+TEST(FillLikeDevkit, InvalidValuesCountAsEmptyAndValidOnesAreKept) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const cv::Mat1f map = (cv::Mat1f(2, 4) << 2, nan, -1, 3, 0, 0, 0, 0);
+  const cv::Mat1f filled = fillLikeDevkit(map, MapKind::kDisparity);
+  const cv::Mat1f expected = (cv::Mat1f(2, 4) << 2, 3, 3, 3, 2, 3, 3, 3);
+  EXPECT_EQ(cv::countNonZero(filled != expected), 0) << filled;
+  EXPECT_EQ(cv::countNonZero(fillLikeDevkit(cv::Mat1f(3, 3, 0.f), MapKind::kDepth)), 0);
+}
+
+TEST(FillLikeDevkit, GapNextToTheBorderIsExtendedNotInterpolated) {
+  // u1 == 0: the devkit skips the gap rule; left extrapolation copies the first estimate.
+  const cv::Mat1f depth = (cv::Mat1f(1, 4) << 0, 0, 8, 3);
+  const cv::Mat1f filled = fillLikeDevkit(depth, MapKind::kDepth);
+  const cv::Mat1f expected = (cv::Mat1f(1, 4) << 8, 8, 8, 3);
+  EXPECT_EQ(cv::countNonZero(filled != expected), 0) << filled;
+}
+
 }  // namespace
 }  // namespace lidar_stereo_fusion

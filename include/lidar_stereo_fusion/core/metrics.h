@@ -39,6 +39,26 @@ struct DisparityMetrics {
 /// Bad-pixel rates count errors strictly greater than 1/2/3/5 px. Throws on a size mismatch.
 DisparityMetrics evaluateDisparity(const cv::Mat1f& disparity, const cv::Mat1f& reference);
 
+/// What a map holds, i.e. which of two values is the nearer one.
+enum class MapKind {
+  kDisparity,  ///< disparity [px]: the larger value is nearer
+  kDepth,      ///< depth [m]: the smaller value is nearer
+};
+
+/// Fills the empty pixels (<= 0 or not finite) of `map` the way the KITTI devkit's
+/// `interpolateBackground` does before scoring (devkit_depth `io_depth.h`, DepthImage; the stereo
+/// devkit `io_disp.h` has the same loops):
+///  1. rows: a gap with an estimate on both sides, not touching the image border, takes the NEARER
+///     of the two bounding values (min depth, as io_depth.h; for kDisparity the max disparity,
+///     i.e. the same rule applied to depth fB/d -- NOTE: io_disp.h takes the min *disparity*, the
+///     farther value, for disparity maps; we follow the depth devkit for both kinds);
+///  2. rows: pixels left of the first / right of the last estimate take that estimate;
+///  3. columns: pixels above the first / below the last value of the column (after 1-2) take it.
+/// Consequently a row without any estimate stays empty (0) when it lies between two filled rows,
+/// exactly as in the devkit; an all-empty map stays empty. Empty pixels come back as 0 (NaN and
+/// negative inputs too); valid values are copied unchanged.
+cv::Mat1f fillLikeDevkit(const cv::Mat1f& map, MapKind kind);
+
 /// Mean over images, each image weighted equally (KITTI devkit convention). Images with count 0
 /// are skipped; `count` is the total over images. No scored image: all zeros, count 0.
 DepthMetrics averageMetrics(const std::vector<DepthMetrics>& per_image);

@@ -21,11 +21,16 @@ struct MiddleburyScene {
 /// size; std::invalid_argument when disparity_scale <= 0.
 MiddleburyScene readMiddleburyScene(const std::string& dir, double disparity_scale = 4.0);
 
-/// Pseudo-LiDAR: `num_rows` evenly spaced rows of `disparity` (row of ring i is
-/// floor((i + 0.5) * rows / num_rows), ring 0 at the top); every pixel of those rows where the
-/// ground truth is > 0 becomes a sample of that ring. points_in_front / points_in_image count the
-/// samples. Throws std::invalid_argument when num_rows < 2 or num_rows > rows.
-SparseDisparity sampleRowsAsScanLines(const cv::Mat1f& disparity, int num_rows);
+/// Pseudo-LiDAR: `num_rows` evenly spaced rows of `disparity` from `first_row` down: the row of
+/// ring i is first_row + floor((i + 0.5) * (rows - first_row) / num_rows), ring 0 at the top
+/// (first_row = 0: the whole image). Every pixel of those rows where the ground truth is > 0
+/// becomes a sample of that ring. points_in_front / points_in_image count the samples. Throws
+/// std::invalid_argument when first_row is not in [0, rows - 2] or num_rows is not in
+/// [2, rows - first_row].
+SparseDisparity sampleRowsAsScanLines(const cv::Mat1f& disparity, int num_rows, int first_row = 0);
+
+/// The image row [px] of `ring` in sampleRowsAsScanLines's layout (no checks).
+int scanLineRow(int ring, int num_rows, int image_rows, int first_row = 0);
 
 /// The same samples seen from the right view: the sample at (x, y) with disparity d moves to
 /// column floor(x - d + 0.5) (as projectCloud's right view does), keeps d and its ring; the larger

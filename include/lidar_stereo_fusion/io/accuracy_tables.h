@@ -1,0 +1,26 @@
+// Markdown tables of the accuracy protocols (io/accuracy_protocols.h). ROS-free.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "lidar_stereo_fusion/io/accuracy_protocols.h"
+
+namespace lidar_stereo_fusion {
+
+/// Main table of a Middlebury layout: one row per method (mean of the scenes, region "all"), the
+/// columns of formatDisparityTable plus raw coverage [%] (before the devkit fill) and time [s].
+/// Then a per-scene table: MAE [px] and bad-2 [%] per scene.
+std::string formatMiddleburyLayout(const LayoutScores<DisparityMetrics>& layout);
+
+/// Main table of a KITTI layout: one row per method (mean over frames, region "all"), the columns
+/// of formatDepthTable plus raw coverage [%] and time [s].
+std::string formatKittiLayout(const LayoutScores<DepthMetrics>& layout);
+
+/// Per-region table: rows = methods, for each region (above, inside, edge, elsewhere) MAE [px]
+/// and bad-2 [%] (Middlebury) or MAE [mm] and >3 px [%] (KITTI); a last row gives each region's
+/// share of the reference pixels [%].
+std::string formatMiddleburyRegions(const LayoutScores<DisparityMetrics>& layout);
+std::string formatKittiRegions(const LayoutScores<DepthMetrics>& layout);
+
+}  // namespace lidar_stereo_fusion
