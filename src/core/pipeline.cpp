@@ -106,6 +106,7 @@ PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
   base.right_iterations = -1;
   base.init_from_prior = false;
   base.use_lidar_bounds = false;
+  base.coarse_scale = 1;  // Bleyer: the search runs at full size
   return base;
 }
 

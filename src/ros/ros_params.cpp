@@ -33,6 +33,13 @@ void visitParams(FusionParams& p, Visitor&& v) {
   v("bf", "sigma_space", p.bf.sigma_space);
   v("bf", "sigma_range", p.bf.sigma_range);
   v("bf", "min_support", p.bf.min_support);
+  v("confidence", "edge_tolerance", p.confidence.edge_tolerance);
+  v("confidence", "edge_sigma", p.confidence.edge_sigma);
+  v("confidence", "max_surface_slope", p.confidence.max_surface_slope);
+  v("confidence", "removed_factor", p.confidence.removed_factor);
+  v("confidence", "near_rows", p.confidence.near_rows);
+  v("confidence", "decay_rows", p.confidence.decay_rows);
+  v("confidence", "hole_confidence", p.confidence.hole_confidence);
   PatchMatchParams& m = p.patchmatch;
   v("patchmatch", "window_radius", m.window_radius);
   v("patchmatch", "window_stride", m.window_stride);
@@ -56,12 +63,18 @@ void visitParams(FusionParams& p, Visitor&& v) {
   v("patchmatch", "view_propagation", m.view_propagation);
   v("patchmatch", "lr_check", m.lr_check);
   v("patchmatch", "lr_max_diff", m.lr_max_diff);
+  v("patchmatch", "confidence_weighting", m.confidence_weighting);
+  v("patchmatch", "lock_confidence", m.lock_confidence);
+  v("patchmatch", "fill_confidence", m.fill_confidence);
+  v("patchmatch", "coarse_scale", m.coarse_scale);
+  v("patchmatch", "fine_iterations", m.fine_iterations);
+  v("patchmatch", "fine_refine_range", m.fine_refine_range);
   v("patchmatch", "num_threads", m.num_threads);
   v("patchmatch", "seed", m.seed);
 }
 
 const std::set<std::string>& groups() {
-  static const std::set<std::string> kGroups = {"projection", "bi", "bf", "patchmatch"};
+  static const std::set<std::string> kGroups = {"projection", "bi", "bf", "confidence", "patchmatch"};
   return kGroups;
 }
 

@@ -67,6 +67,19 @@ FusionParams everyFieldChanged() {
   m.view_propagation = false;
   m.lr_check = false;
   m.lr_max_diff = 1.5;
+  m.confidence_weighting = false;
+  m.lock_confidence = 0.75;
+  m.fill_confidence = 0.25;
+  m.coarse_scale = 2;
+  m.fine_iterations = 2;
+  m.fine_refine_range = 1.5;
+  p.confidence.edge_tolerance = 0.25;
+  p.confidence.edge_sigma = 2.5;
+  p.confidence.max_surface_slope = 0.5;
+  p.confidence.removed_factor = 0.5;
+  p.confidence.near_rows = 3.0;
+  p.confidence.decay_rows = 8.0;
+  p.confidence.hole_confidence = 0.125;
   m.num_threads = 3;
   m.seed = 18446744073709551557ull;  // beyond int32 and double precision
   return p;
@@ -108,6 +121,20 @@ void expectSame(const FusionParams& a, const FusionParams& b) {
   EXPECT_EQ(x.view_propagation, y.view_propagation);
   EXPECT_EQ(x.lr_check, y.lr_check);
   EXPECT_EQ(x.lr_max_diff, y.lr_max_diff);
+  EXPECT_EQ(x.confidence_weighting, y.confidence_weighting);
+  EXPECT_EQ(x.lock_confidence, y.lock_confidence);
+  EXPECT_EQ(x.fill_confidence, y.fill_confidence);
+  EXPECT_EQ(x.coarse_scale, y.coarse_scale);
+  EXPECT_EQ(x.fine_iterations, y.fine_iterations);
+  EXPECT_EQ(x.fine_refine_range, y.fine_refine_range);
+  const PriorConfidenceParams &c = a.confidence, &d = b.confidence;
+  EXPECT_EQ(c.edge_tolerance, d.edge_tolerance);
+  EXPECT_EQ(c.edge_sigma, d.edge_sigma);
+  EXPECT_EQ(c.max_surface_slope, d.max_surface_slope);
+  EXPECT_EQ(c.removed_factor, d.removed_factor);
+  EXPECT_EQ(c.near_rows, d.near_rows);
+  EXPECT_EQ(c.decay_rows, d.decay_rows);
+  EXPECT_EQ(c.hole_confidence, d.hole_confidence);
   EXPECT_EQ(x.num_threads, y.num_threads);
   EXPECT_EQ(x.seed, y.seed);
 }
@@ -137,6 +164,7 @@ TEST(ParamsYaml, EveryFieldRoundTrips) {
 TEST(ParamsYaml, DefaultsRoundTripAndThirdDecimalsSurvive) {
   FusionParams p;
   p.patchmatch.alpha = 0.1;
+  p.patchmatch.beta = 0.0;
   p.patchmatch.gamma = 0.9;  // 0.1 + 0.9 needs the exact doubles back
   YamlFile file;
   saveParamsYaml(file.path(), p);
@@ -187,6 +215,23 @@ TEST(ParamsYaml, TheShippedConfigLoadsAndKeepsTheDefaults) {
   FusionParams p;
   loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/fusion.yaml", p);
   expectSame(p, FusionParams());
+}
+
+// config/paper.yaml is the paper's cost and constants; everything else stays at the defaults.
+TEST(ParamsYaml, ThePaperPresetHasThePapersCostAndWindow) {
+  FusionParams p;
+  loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/paper.yaml", p);
+  EXPECT_EQ(p.method, Method::kFusedBI);
+  EXPECT_FALSE(p.patchmatch.confidence_weighting);
+  EXPECT_EQ(p.patchmatch.alpha, 0.1);
+  EXPECT_EQ(p.patchmatch.beta, 0.0);
+  EXPECT_EQ(p.patchmatch.gamma, 0.9);
+  EXPECT_EQ(p.patchmatch.window_radius, 5);
+  EXPECT_EQ(p.patchmatch.window_stride, 5);
+  EXPECT_EQ(p.patchmatch.coarse_scale, 1);
+  FusionParams expected;
+  expected.patchmatch = p.patchmatch;  // the rest must be the defaults
+  expectSame(p, expected);
 }
 
 TEST(ParamsYaml, OpenCvStyleFileWithDirectiveAndEmptyFileAreAccepted) {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <utility>
 
 #include <opencv2/core.hpp>
 
@@ -13,14 +14,19 @@
 namespace lidar_stereo_fusion {
 
 struct PatchMatchParams {
-  int window_radius = 5;         ///< support window is (2r+1)^2 [px]; paper: best near size 10
-  /// Window offsets used are the multiples of k within the radius: 5 samples the 11x11 window at
-  /// 3x3 points (-5, 0, 5), which on KITTI was as accurate as 5x5 points and 1.7x faster.
-  int window_stride = 5;
+  /// Support window (2r+1)^2 [px]. The paper found size ~10 best for its fused cost, ~40 for plain
+  /// PMS; with confidence weighting the images lead where the LiDAR is absent, and need plain
+  /// stereo's support there: 17x17 (sampled every 2nd pixel: 9x9 points) won on every protocol.
+  int window_radius = 8;
+  /// Window offsets used are the multiples of k within the radius (2: -8, -6, ..., 8).
+  int window_stride = 2;
   double weight_delta = 10.0;    ///< delta of w = exp(-|I_p - I_p'|_1 / delta)
-  double alpha = 0.1;            ///< colour weight
-  double beta = 0.0;             ///< gradient weight
-  double gamma = 0.9;            ///< LiDAR disparity weight (alpha + beta + gamma = 1)
+  /// Weights of colour, gradient and LiDAR terms, alpha + beta + gamma = 1. The paper: 0.1, 0,
+  /// 0.9. Default: gamma 0.9 where the LiDAR is sure, and an image term of Bleyer's mix (1 : 9
+  /// colour : gradient), which confidence weighting renormalises to full weight without LiDAR.
+  double alpha = 0.01;
+  double beta = 0.09;
+  double gamma = 0.9;
   double lambda_col = 10.0;      ///< colour truncation (RGB L1 distance, 0..765 scale)
   double lambda_grad = 2.0;      ///< gradient truncation
   double lambda_disp = 2.0;      ///< disparity truncation [px]; also the cost where the prior is empty
@@ -46,13 +52,13 @@ struct PatchMatchParams {
   bool confidence_weighting = true;
   /// Pixels whose prior confidence is >= this keep the prior's plane and are not searched (the
   /// LiDAR is sure there; > 1 = search every pixel). Only with confidence_weighting.
-  double lock_confidence = 0.9;
+  double lock_confidence = 0.5;
   /// Inconsistent pixels (left-right check) take the prior where its confidence is >= this.
   double fill_confidence = 0.5;
   /// Coarse start (patchmatch/coarse_to_fine.h): the search first runs on images reduced by this
   /// factor (1 = off), then `fine_iterations` sweeps at full size start from its planes, refining
   /// unbounded pixels from +-fine_refine_range instead of half the image's disparity range.
-  int coarse_scale = 1;
+  int coarse_scale = 4;
   int fine_iterations = 1;
   double fine_refine_range = 2.0;  ///< [px]
   int num_threads = 0;           ///< 0 = all cores (at most 256)
@@ -71,6 +77,14 @@ struct PatchMatchResult {
 
 /// Inputs of one view.
 struct ViewInput {
+  ViewInput() = default;
+  ViewInput(cv::Mat image_, cv::Mat1f prior_ = cv::Mat1f(), ScanLineBounds bounds_ = {},
+            cv::Mat1f confidence_ = cv::Mat1f())
+      : image(std::move(image_)),
+        prior(std::move(prior_)),
+        bounds(std::move(bounds_)),
+        confidence(std::move(confidence_)) {}
+
   cv::Mat image;            ///< BGR CV_8UC3 (or grey CV_8UC1) rectified image
   cv::Mat1f prior;          ///< up-sampled LiDAR disparity of this view, 0 = empty (may be empty())
   ScanLineBounds bounds;    ///< search bounds from the scan lines (may be empty())

@@ -12,6 +12,8 @@
 #include <string>
 
 #include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/view_state.h"
+#include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
 #include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
 #include "lidar_stereo_fusion/core/patchmatch/propagation.h"
 
@@ -21,6 +23,17 @@ namespace {
 
 void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument("PatchMatchParams: " + message);
+}
+
+cv::Mat3f planeMap(const patchmatch::ViewState& v) {
+  cv::Mat3f map(v.height, v.width);
+  for (int y = 0; y < v.height; ++y) {
+    for (int x = 0; x < v.width; ++x) {
+      const patchmatch::Plane& pl = v.planes[y * v.width + x];
+      map(y, x) = cv::Vec3f(pl.a, pl.b, pl.c);
+    }
+  }
+  return map;
 }
 
 }  // namespace
@@ -46,6 +59,9 @@ void PatchMatchParams::validate() const {
   require(std::isfinite(lock_confidence) && lock_confidence >= 0,
           "lock_confidence must be >= 0 (> 1 = never lock)");
   require(fill_confidence >= 0 && fill_confidence <= 1, "fill_confidence must be in [0, 1]");
+  require(coarse_scale >= 1 && coarse_scale <= 16, "coarse_scale must be in [1, 16] (1 = off)");
+  require(fine_iterations >= 1 && fine_iterations <= 100, "fine_iterations must be in [1, 100]");
+  require(std::isfinite(fine_refine_range) && fine_refine_range > 0, "fine_refine_range must be > 0");
   require(num_threads >= 0 && num_threads <= 256, "num_threads must be in [0, 256] (0 = all cores)");
 }
 
@@ -74,6 +90,18 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   prepareView(right, p, +1.f, rv);
   const bool two_views = p.view_propagation || p.lr_check;
 
+  int iterations = p.iterations;
+  if (p.coarse_scale > 1 && std::min(size.width, size.height) >= 4 * p.coarse_scale) {
+    // Coarse start: its planes, up-sampled, are where the full-size search begins.
+    if (!coarse_) coarse_ = std::make_shared<PatchMatchStereo>(coarseParams(p));
+    coarse_->setParams(coarseParams(p));
+    const PatchMatchResult coarse = coarse_->compute(downsampleView(left, p.coarse_scale),
+                                                     downsampleView(right, p.coarse_scale));
+    lv.guide = upsamplePlanes(coarse.planes, p.coarse_scale, size);
+    if (two_views) rv.guide = upsamplePlanes(coarse.right_planes, p.coarse_scale, size);
+    iterations = p.fine_iterations;
+  }
+
   PlaneSearch left_search(p, lv, rv);
   PlaneSearch right_search(p, rv, lv);
   initialise(left_search, lv, p, 0);
@@ -82,11 +110,11 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   // propagation and the left-right check; view propagation runs around its sweeps (left -> right
   // before, right -> left after), since in the other iterations the right view would only hand
   // the left view's own planes back.
-  const int right_iterations = p.right_iterations < 0 ? p.iterations
-                                                      : std::min(p.right_iterations, p.iterations);
-  for (int it = 0; it < p.iterations; ++it) {
+  const int right_iterations = p.right_iterations < 0 ? iterations
+                                                      : std::min(p.right_iterations, iterations);
+  for (int it = 0; it < iterations; ++it) {
     sweep(left_search, lv, p, it);
-    if (!two_views || it < p.iterations - right_iterations) continue;
+    if (!two_views || it < iterations - right_iterations) continue;
     if (p.view_propagation) propagateView(lv, right_search, rv, p, true);
     sweep(right_search, rv, p, it);
     if (p.view_propagation) propagateView(rv, left_search, lv, p, false);
@@ -94,14 +122,11 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
 
   PatchMatchResult result;
   result.disparity = disparityOf(lv);
-  result.planes.create(size);
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const Plane& pl = lv.planes[y * size.width + x];
-      result.planes(y, x) = cv::Vec3f(pl.a, pl.b, pl.c);
-    }
+  result.planes = planeMap(lv);
+  if (two_views) {
+    result.right_disparity = disparityOf(rv);
+    result.right_planes = planeMap(rv);
   }
-  if (two_views) result.right_disparity = disparityOf(rv);
   if (p.lr_check) {
     result.inconsistent = leftRightCheck(result.disparity, result.right_disparity,
                                          static_cast<float>(p.lr_max_diff), lv.locked,
