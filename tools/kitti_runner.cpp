@@ -40,7 +40,8 @@ Options:
                        not scored): MAE, RMSE [mm], iMAE, iRMSE [1/km], disparity >2/3/5 px
   --holdout even|none  even: feed the even LiDAR rings only and score against the odd rings'
                        depth (a ground-truth-free accuracy check; excludes --reference)
-  --save-vis           also write <out>/vis/<frame>_{sparse,prior,disparity,depth,error}.png
+  --save-vis           also write <out>/vis/<frame>_{sparse,prior,confidence,disparity,depth,
+                       error}.png (confidence of the prior: dark = 0, yellow = 1)
   --frames N           process only the first N frames
   --help               this text
 
@@ -125,6 +126,8 @@ void saveVisualisation(const fs::path& dir, const std::string& name, const cv::M
              lsf::overlaySparse(left, result.sparse.disparity, max_disparity));
   if (!result.prior.empty()) {
     writeImage(dir / (name + "_prior.png"), lsf::colorizeDisparity(result.prior, max_disparity));
+    writeImage(dir / (name + "_confidence.png"),
+               lsf::colorizeConfidence(result.confidence, result.prior));
   }
   writeImage(dir / (name + "_disparity.png"),
              lsf::colorizeDisparity(result.disparity, max_disparity));

@@ -328,6 +328,8 @@ fs::path writePictures(const DemoCase& c, const std::vector<MethodRun>& runs, co
   }
   if (const MethodRun* r = findRun(runs, lsf::Method::kFusedBI)) {
     add("prior_bi.png", lsf::colorizeDisparity(r->result.prior, max_d), "BI* up-sampled LiDAR");
+    add("prior_confidence.png", lsf::colorizeConfidence(r->result.confidence, r->result.prior),
+        "confidence of the prior (dark 0 .. yellow 1)");
   }
   for (lsf::Method m : {lsf::Method::kFusedBI, lsf::Method::kPlainPMS, lsf::Method::kFusedBF}) {
     const MethodRun* r = findRun(runs, m);

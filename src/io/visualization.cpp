@@ -57,6 +57,21 @@ cv::Mat colorizeDisparity(const cv::Mat1f& disparity, double max_disparity) {
   return colorize(level, mask);
 }
 
+cv::Mat colorizeConfidence(const cv::Mat1f& confidence, const cv::Mat1f& prior) {
+  requireNonEmpty(confidence, "colorizeConfidence");
+  if (prior.size() != confidence.size()) {
+    throw std::invalid_argument("colorizeConfidence: prior and confidence differ in size");
+  }
+  cv::Mat1b level(confidence.size(), uint8_t{0});
+  for (int y = 0; y < confidence.rows; ++y) {
+    for (int x = 0; x < confidence.cols; ++x) level(y, x) = toLevel(confidence(y, x));
+  }
+  cv::Mat color;
+  cv::applyColorMap(level, color, cv::COLORMAP_VIRIDIS);
+  color.setTo(cv::Scalar::all(0), ~(prior > 0.f));
+  return color;
+}
+
 cv::Mat colorizeDepth(const cv::Mat1f& depth, double max_depth) {
   requireNonEmpty(depth, "colorizeDepth");
   if (!(max_depth > 0)) throw std::invalid_argument("colorizeDepth: max_depth must be > 0 [m]");

@@ -150,6 +150,7 @@ TEST(KittiRunner, WritesKittiDepthPngsOfImageSizeAndScoresAReference) {
     EXPECT_GT(cv::countNonZero(depth), 500);
     EXPECT_LE(max_depth, 10.0 + 1.0 / 256);
     EXPECT_TRUE(fs::exists(out + "/vis/" + name + "_disparity.png"));
+    EXPECT_TRUE(fs::exists(out + "/vis/" + name + "_confidence.png"));
   }
   EXPECT_NE(r.out.find("| projection |"), std::string::npos) << r.out;  // timing summary
   EXPECT_NE(r.err.find("3/3"), std::string::npos) << r.err;             // progress bar

@@ -1,98 +1,104 @@
-// Middlebury 2003 cones and teddy (quarter size) with a pseudo-LiDAR: 64 evenly spaced rows of the
-// ground truth, every pixel of those rows where it exists, rows as rings 0..63. The fused method
-// (BI* up-sampling + guided PatchMatch) must beat LiDAR-only BI* interpolation and plain PMS on
-// bad-2 and MAE over all ground-truth pixels (missing estimates count as errors of the full
-// disparity).
-//
-// The stages are composed here from upsampling.h and patchmatch.h the way FusionPipeline::process
-// composes them (BI* in both views, scan-line bounds, PatchMatch), because the pipeline takes a
-// point cloud and this input is a disparity map.
+// Middlebury 2003 cones and teddy (quarter size) with a pseudo-LiDAR sampled from the ground truth
+// on 64 rows, 16 rows, and 42 rows over the lower 2/3 only (io/accuracy_protocols.h), scored over
+// every ground-truth pixel after the KITTI devkit's fill. On every layout (mean of the two scenes)
+// the default fused method must have a lower MAE and a lower bad-2 rate than each of LiDAR-only
+// BI*, plain PMS, "LiDAR-only else PMS" and the nearest-point fill, by a margin; and the paper
+// preset must reproduce the fused_bi numbers of the package before confidence weighting.
 #include <iostream>
 
 #include <gtest/gtest.h>
 
 #include "data/data_guard.h"
-#include "lidar_stereo_fusion/core/metrics.h"
-#include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/io/accuracy_protocols.h"
 #include "lidar_stereo_fusion/io/middlebury.h"
-#include "lidar_stereo_fusion/io/report.h"
+#include "lidar_stereo_fusion/io/params_yaml.h"
 
 namespace lidar_stereo_fusion {
 namespace {
 
-constexpr int kRings = 64;
+/// The fused method must beat every baseline by this fraction of the baseline's score.
+constexpr double kMargin = 0.10;
 
-/// Default parameters with the image-wide disparity range of the quarter-size scenes (GT <= 64).
-FusionParams middleburyParams() {
-  FusionParams params;
-  params.patchmatch.min_disparity = 1.0;
-  params.patchmatch.max_disparity = 64.0;
-  return params;
+const DisparityMetrics& all(const LayoutScores<DisparityMetrics>& layout, const std::string& m) {
+  const MethodScores<DisparityMetrics>* scores = layout.find(m);
+  if (!scores) throw std::runtime_error("method " + m + " did not run on " + layout.name);
+  return scores->mean[static_cast<int>(Region::kAll)];
 }
 
-struct ViewPrior {
-  cv::Mat1f prior;
-  ScanLineBounds bounds;
-};
-
-ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
-                       const FusionParams& params) {
-  ViewPrior view;
-  ScanLines lines;
-  view.prior = upsampleBI(sparse, image, params.bi, nullptr, &lines);
-  view.bounds = computeScanLineBounds(lines, params.patchmatch.bound_margin);
-  return view;
+const std::vector<LayoutScores<DisparityMetrics>>& results() {
+  static const std::vector<LayoutScores<DisparityMetrics>> layouts = [] {
+    AccuracyOptions options;
+    options.data_dir = LSF_DATA_DIR;
+    FusionParams paper;
+    loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/paper.yaml", paper);
+    options.paper = paper;
+    options.methods = {"fused", "paper", "lidar_bi", "pms", "lidar_bi else pms", "nearest"};
+    return runMiddleburyProtocol(options);
+  }();
+  return layouts;
 }
 
-struct SceneResult {
-  DisparityMetrics lidar_bi, fused_bi, pms;
-};
-
-SceneResult runScene(const std::string& name) {
-  const MiddleburyScene scene = readMiddleburyScene(test::dataPath("middlebury/" + name));
-  const FusionParams params = middleburyParams();
-  const SparseDisparity left_sparse = sampleRowsAsScanLines(scene.disparity, kRings);
-  const SparseDisparity right_sparse = shiftToRightView(left_sparse);
-  const ViewPrior left = upsampleView(left_sparse, scene.left, params);
-  const ViewPrior right = upsampleView(right_sparse, scene.right, params);
-
-  PatchMatchStereo fused(params.patchmatch);
-  const cv::Mat1f fused_disparity =
-      fused.compute({scene.left, left.prior, left.bounds}, {scene.right, right.prior, right.bounds})
-          .disparity;
-  PatchMatchStereo plain(FusionParams::plainPmsParams(params.patchmatch));
-  const cv::Mat1f pms_disparity = plain
-                                      .compute({scene.left, cv::Mat1f(), ScanLineBounds(), cv::Mat1f()},
-                                               {scene.right, cv::Mat1f(), ScanLineBounds(), cv::Mat1f()})
-                                      .disparity;
-
-  SceneResult result;
-  result.lidar_bi = evaluateDisparity(left.prior, scene.disparity);
-  result.fused_bi = evaluateDisparity(fused_disparity, scene.disparity);
-  result.pms = evaluateDisparity(pms_disparity, scene.disparity);
-  std::cout << "Middlebury " << name << " (quarter size, " << kRings
-            << " ground-truth rows as pseudo-LiDAR, " << left_sparse.points_in_image
-            << " samples; seed " << params.patchmatch.seed << "):\n"
-            << formatDisparityTable({{"lidar_bi", result.lidar_bi},
-                                     {"fused_bi", result.fused_bi},
-                                     {"pms", result.pms}});
-  return result;
+void expectFusedBeatsEveryBaseline(const std::string& name) {
+  for (const auto& layout : results()) {
+    if (layout.name != name) continue;
+    const DisparityMetrics& fused = all(layout, "fused");
+    std::cout << name << ": fused MAE " << fused.mae_px << " px, bad-2 " << 100 * fused.bad2
+              << " %\n";
+    for (const char* baseline : {"lidar_bi", "pms", "lidar_bi else pms", "nearest"}) {
+      const DisparityMetrics& b = all(layout, baseline);
+      std::cout << "  " << baseline << ": MAE " << b.mae_px << " px, bad-2 " << 100 * b.bad2
+                << " %\n";
+      EXPECT_LT(fused.mae_px, (1 - kMargin) * b.mae_px) << name << " vs " << baseline;
+      EXPECT_LT(fused.bad2, (1 - kMargin) * b.bad2) << name << " vs " << baseline;
+    }
+    return;
+  }
+  FAIL() << "layout " << name << " did not run";
 }
 
-void expectFusedBeatsBaselines(const std::string& name) {
-  const SceneResult r = runScene(name);
-  const uint64_t seed = middleburyParams().patchmatch.seed;
-  EXPECT_LT(r.fused_bi.bad2, r.lidar_bi.bad2) << name << ", seed " << seed;
-  EXPECT_LT(r.fused_bi.mae_px, r.lidar_bi.mae_px) << name << ", seed " << seed;
-  EXPECT_LT(r.fused_bi.bad2, r.pms.bad2) << name << ", seed " << seed;
-  EXPECT_LT(r.fused_bi.mae_px, r.pms.mae_px) << name << ", seed " << seed;
+TEST(Middlebury, FusedBeatsEveryBaselineWith64Rows) {
+  LSF_REQUIRE_DATA("middlebury/cones");
+  LSF_REQUIRE_DATA("middlebury/teddy");
+  expectFusedBeatsEveryBaseline("mb64");
+}
+
+TEST(Middlebury, FusedBeatsEveryBaselineWith16Rows) {
+  LSF_REQUIRE_DATA("middlebury/cones");
+  LSF_REQUIRE_DATA("middlebury/teddy");
+  expectFusedBeatsEveryBaseline("mb16");
+}
+
+TEST(Middlebury, FusedBeatsEveryBaselineWithRowsInTheLowerTwoThirdsOnly) {
+  LSF_REQUIRE_DATA("middlebury/cones");
+  LSF_REQUIRE_DATA("middlebury/teddy");
+  expectFusedBeatsEveryBaseline("mb42low");
+}
+
+// The fused_bi numbers of the package before confidence weighting (same protocol, devkit fill),
+// which config/paper.yaml must reproduce within 1 %.
+TEST(Middlebury, PaperPresetReproducesThePreviousFusedNumbers) {
+  LSF_REQUIRE_DATA("middlebury/cones");
+  LSF_REQUIRE_DATA("middlebury/teddy");
+  struct Reference {
+    const char* layout;
+    double mae_px, bad2;
+  };
+  for (const Reference& ref : {Reference{"mb64", 0.223, 0.0273}, Reference{"mb16", 1.026, 0.1285},
+                               Reference{"mb42low", 1.428, 0.1522}}) {
+    for (const auto& layout : results()) {
+      if (layout.name != ref.layout) continue;
+      const DisparityMetrics& paper = all(layout, "paper");
+      EXPECT_NEAR(paper.mae_px, ref.mae_px, 0.01 * ref.mae_px) << ref.layout;
+      EXPECT_NEAR(paper.bad2, ref.bad2, 0.01 * ref.bad2) << ref.layout;
+    }
+  }
 }
 
 TEST(Middlebury, PseudoLidarRowsAreExactGroundTruthSamples) {
   LSF_REQUIRE_DATA("middlebury/cones");
   const MiddleburyScene scene = readMiddleburyScene(test::dataPath("middlebury/cones"));
   ASSERT_EQ(scene.left.size(), cv::Size(450, 375));
-  const SparseDisparity sparse = sampleRowsAsScanLines(scene.disparity, kRings);
+  const SparseDisparity sparse = sampleRowsAsScanLines(scene.disparity, 64);
   int rows_with_samples = 0;
   for (int y = 0; y < sparse.disparity.rows; ++y) {
     int samples = 0;
@@ -105,17 +111,7 @@ TEST(Middlebury, PseudoLidarRowsAreExactGroundTruthSamples) {
     }
     rows_with_samples += samples > 0;
   }
-  EXPECT_EQ(rows_with_samples, kRings);
-}
-
-TEST(Middlebury, FusedBeatsLidarOnlyAndPlainPmsOnCones) {
-  LSF_REQUIRE_DATA("middlebury/cones");
-  expectFusedBeatsBaselines("cones");
-}
-
-TEST(Middlebury, FusedBeatsLidarOnlyAndPlainPmsOnTeddy) {
-  LSF_REQUIRE_DATA("middlebury/teddy");
-  expectFusedBeatsBaselines("teddy");
+  EXPECT_EQ(rows_with_samples, 64);
 }
 
 }  // namespace

@@ -19,6 +19,10 @@ cv::Mat colorizeDepth(const cv::Mat1f& depth, double max_depth = 80.0);
 cv::Mat colorizeError(const cv::Mat1f& estimate, const cv::Mat1f& reference,
                       double max_error = 5.0);
 
+/// Colourises the prior's confidence [0, 1] (VIRIDIS: dark violet = 0, yellow = 1) where `prior`
+/// has a value; black where it has none (confidence 0 by definition). Returns BGR8.
+cv::Mat colorizeConfidence(const cv::Mat1f& confidence, const cv::Mat1f& prior);
+
 /// Draws sparse LiDAR disparity as coloured dots over a darkened copy of `image`. Returns BGR8.
 cv::Mat overlaySparse(const cv::Mat& image, const cv::Mat1f& sparse, double max_disparity = 0.0);
 
