@@ -34,7 +34,7 @@ folder (calib_cam_to_cam.txt, calib_velo_to_cam.txt).
 Options:
   --kitti-raw <dir>    the drive, e.g. .../2011_09_26/2011_09_26_drive_0009_sync
   --out <dir>          output folder (created)
-  --method <name>      fused_bi (default, the paper) | fused_bf | pms | lidar_bi | lidar_bf
+  --method <name>      fused_bi (default; the paper: --params config/paper.yaml) | fused_bf | pms | lidar_bi | lidar_bf
   --params <yaml>      parameters (see config/*.yaml); --method overrides its 'method'
   --reference <dir>    score against KITTI depth PNGs <dir>/<frame>.png (frames without one are
                        not scored): MAE, RMSE [mm], iMAE, iRMSE [1/km], disparity >2/3/5 px
