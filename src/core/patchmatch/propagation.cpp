@@ -75,7 +75,7 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   if (self_.isLocked(idx)) return;
   cost_.buildWindow(x, y, cache);
   Plane best = self_.planes[idx];
-  float best_cost = self_.cost[idx];
+  float best_cost = currentCost(idx, cache);
   // Spatial propagation: forward sweeps look left/up, backward sweeps right/down.
   const int step = forward ? -1 : 1;
   const int nx = x + step, ny = y + step;
@@ -87,6 +87,13 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   refine(x, y, cache, rng, best, best_cost);
   self_.planes[idx] = best;
   self_.cost[idx] = best_cost;
+}
+
+float PlaneSearch::currentCost(int idx, const WindowCache& cache) const {
+  if (self_.cost[idx] == kUnknownCost) {
+    self_.cost[idx] = cost_.aggregate(cache, self_.planes[idx], std::numeric_limits<float>::max());
+  }
+  return self_.cost[idx];
 }
 
 void PlaneSearch::tryPlane(int x, int y, const Plane& candidate, const WindowCache& cache,
@@ -143,16 +150,15 @@ int threadCount(const PatchMatchParams& p) {
 }
 
 void initialise(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int view) {
+  // The cost of an initial plane is computed when the pixel is first visited (currentCost), with
+  // the window the visit builds anyway; locked pixels are never compared.
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threadCount(p))
   for (int y = 0; y < v.height; ++y) {
-    WindowCache cache;
     for (int x = 0; x < v.width; ++x) {
       const int idx = y * v.width + x;
       Rng rng(streamKey(p.seed, view, -1, idx));
       v.planes[idx] = search.initialPlane(x, y, rng);
-      if (v.isLocked(idx)) continue;  // never compared: locked pixels are not searched
-      search.cost().buildWindow(x, y, cache);
-      v.cost[idx] = search.cost().aggregate(cache, v.planes[idx], std::numeric_limits<float>::max());
+      v.cost[idx] = kUnknownCost;
     }
   }
 }

@@ -22,11 +22,11 @@ void propagateView(const ViewState& src, const PlaneSearch& dst_search, ViewStat
       if (dst.isLocked(idx)) continue;
       const Plane moved = transferPlane(plane, left_to_right);
       Plane best = dst.planes[idx];
-      float best_cost = dst.cost[idx];
       const float fxq = static_cast<float>(xq);
       if (nearlySame(best, moved, fxq, fy)) continue;
       if (!dst_search.admissible(xq, y, moved.at(fxq, fy))) continue;
       dst_search.cost().buildWindow(xq, y, cache);
+      float best_cost = dst_search.currentCost(idx, cache);
       dst_search.tryPlane(xq, y, moved, cache, best, best_cost);
       dst.planes[idx] = best;
       dst.cost[idx] = best_cost;

@@ -47,6 +47,10 @@ class PlaneSearch {
   void tryPlane(int x, int y, const Plane& candidate, const WindowCache& cache, Plane& best,
                 float& best_cost) const;
 
+  /// The cost of the pixel's current plane over `cache` (its window), computed and stored on the
+  /// first call after initialisation.
+  float currentCost(int idx, const WindowCache& cache) const;
+
   /// Plane refinement (random perturbations of d and n, halving ranges).
   void refine(int x, int y, const WindowCache& cache, Rng& rng, Plane& best,
               float& best_cost) const;
@@ -65,7 +69,10 @@ class PlaneSearch {
 
 constexpr int kStripRows = 12;
 
-/// Initial planes and their costs of a view (view 0 = left, 1 = right).
+/// Marks a cost not computed yet (ViewState::cost after initialise).
+constexpr float kUnknownCost = -1.f;
+
+/// Initial planes of a view (view 0 = left, 1 = right); their costs are left kUnknownCost.
 void initialise(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int view);
 
 /// One sweep of spatial propagation + refinement over a view (strips in two phases).
