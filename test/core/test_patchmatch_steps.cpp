@@ -19,7 +19,9 @@ namespace pm = lidar_stereo_fusion::patchmatch;
 namespace {
 
 /// Uniform images: every support weight is 1 and every gradient 0.
-cv::Mat uniform(int w, int h, uchar value) { return cv::Mat(h, w, CV_8UC3, cv::Scalar::all(value)); }
+cv::Mat uniform(int w, int h, uchar value) {
+  return cv::Mat(h, w, CV_8UC3, cv::Scalar::all(value));
+}
 
 lsf::PatchMatchParams params3x3() {
   lsf::PatchMatchParams p;  // defaults: alpha 0.01, beta 0.09, gamma 0.9, weighted
@@ -90,8 +92,8 @@ TEST(PatchMatchCost, ConfidenceWeightsTheLidarTermAndTheImageTermTakesTheRest) {
   cv::Mat1f prior(9, 12, 5.f), conf(9, 12, 0.5f);
   const Views v = prepare({uniform(12, 9, 100), prior, {}, conf}, {uniform(12, 9, 104)}, p);
   const pm::MatchingCost cost(p, v.left, v.right);
-  // kappa = 0.9 * 0.5 = 0.45: phi = 0.55 / (alpha + beta) * alpha min(12, 10) + 0.45 min(|5 - 6|, 2)
-  // = 0.55 + 0.45 = 1 per sample (every match of pixel 9's window lies inside the right image).
+  // kappa = 0.9 * 0.5 = 0.45: phi = 0.55 / (alpha + beta) * alpha min(12, 10) + 0.45 min(|5 - 6|,
+  // 2) = 0.55 + 0.45 = 1 per sample (every match of pixel 9's window lies inside the right image).
   EXPECT_FLOAT_EQ(costOf(cost, 9, 4, pm::Plane{0.f, 0.f, 6.f}), 9.f);
   // A match outside the other image costs the truncations: alpha 10 + beta 2 = 0.28 before the
   // factor 5.5, so pixel 6's left column (matches at x = -1) costs 1.54 + 0.45 per sample.

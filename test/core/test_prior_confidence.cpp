@@ -121,8 +121,9 @@ TEST(PriorConfidence, RejectsInvalidParamsAndSizes) {
   p = lsf::PriorConfidenceParams();
   p.removed_factor = 1.5;
   EXPECT_THROW(lsf::priorConfidence(lines, prior, {}, p), std::invalid_argument);
-  EXPECT_THROW(lsf::priorConfidence(lines, cv::Mat1f::zeros(5, 4), {}, lsf::PriorConfidenceParams()),
-               std::invalid_argument);
+  EXPECT_THROW(
+      lsf::priorConfidence(lines, cv::Mat1f::zeros(5, 4), {}, lsf::PriorConfidenceParams()),
+      std::invalid_argument);
 }
 
 TEST(FillPriorHoles, RowGapsTakeTheNearerEndRowEndsAndTheBottomAreExtended) {

@@ -57,10 +57,11 @@ cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
 /// row, a gap between two prior values takes the nearer of the two (the larger disparity), as the
 /// KITTI devkit's interpolateBackground does for the benchmark, and the row ends take the first /
 /// last value; below the bottom value of a column, that value. Rows without a value and pixels
-/// above the top scan line (beyond the LiDAR's field of view) stay empty. Filled pixels get confidence params.hole_confidence: a weak pull that decides
-/// where the images cannot (a dark, textureless car body that returned few LiDAR points) and
-/// yields to them where they can. Nothing happens when hole_confidence is 0. Returns the number of
-/// pixels filled. Throws std::invalid_argument for maps of different sizes.
+/// above the top scan line (beyond the LiDAR's field of view) stay empty. Filled pixels get
+/// confidence params.hole_confidence: a weak pull that decides where the images cannot (a dark,
+/// textureless car body that returned few LiDAR points) and yields to them where they can. Nothing
+/// happens when hole_confidence is 0. Returns the number of pixels filled. Throws
+/// std::invalid_argument for maps of different sizes.
 int fillPriorHoles(cv::Mat1f& prior, cv::Mat1f& confidence, const PriorConfidenceParams& params);
 
 }  // namespace lidar_stereo_fusion

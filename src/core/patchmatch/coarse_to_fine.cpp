@@ -23,7 +23,8 @@ cv::Mat1f reduceMap(const cv::Mat1f& map, const cv::Size& size, int scale, float
   for (int y = 0; y < size.height; ++y) {
     const float* src = map[std::min(map.rows - 1, y * scale + scale / 2)];
     float* dst = out[y];
-    for (int x = 0; x < size.width; ++x) dst[x] = src[std::min(map.cols - 1, x * scale + scale / 2)] * factor;
+    for (int x = 0; x < size.width; ++x)
+      dst[x] = src[std::min(map.cols - 1, x * scale + scale / 2)] * factor;
   }
   return out;
 }
@@ -46,7 +47,8 @@ ViewInput downsampleView(const ViewInput& in, int scale) {
 PatchMatchParams coarseParams(const PatchMatchParams& p) {
   PatchMatchParams c = p;
   const int s = p.coarse_scale;
-  c.window_radius = std::max(1, static_cast<int>(std::lround(static_cast<double>(p.window_radius) / s)));
+  c.window_radius =
+      std::max(1, static_cast<int>(std::lround(static_cast<double>(p.window_radius) / s)));
   c.window_stride = std::min(c.window_radius, std::max(1, p.window_stride / s));
   c.min_disparity = p.min_disparity / s;
   c.max_disparity = p.max_disparity / s;
@@ -66,7 +68,8 @@ std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::
     const cv::Vec3f* row = coarse[std::min(coarse.rows - 1, y / scale)];
     for (int x = 0; x < full.width; ++x) {
       const cv::Vec3f& q = row[std::min(coarse.cols - 1, x / scale)];
-      planes[static_cast<size_t>(y) * full.width + x] = Plane{q[0], q[1], s * q[2] - offset * (q[0] + q[1])};
+      planes[static_cast<size_t>(y) * full.width + x] =
+          Plane{q[0], q[1], s * q[2] - offset * (q[0] + q[1])};
     }
   }
   return planes;

@@ -12,10 +12,10 @@
 #include <string>
 
 #include "lidar_stereo_fusion/core/patchmatch.h"
-#include "lidar_stereo_fusion/core/patchmatch/view_state.h"
 #include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
 #include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
 #include "lidar_stereo_fusion/core/patchmatch/propagation.h"
+#include "lidar_stereo_fusion/core/patchmatch/view_state.h"
 
 namespace lidar_stereo_fusion {
 
@@ -61,11 +61,14 @@ void PatchMatchParams::validate() const {
   require(fill_confidence >= 0 && fill_confidence <= 1, "fill_confidence must be in [0, 1]");
   require(coarse_scale >= 1 && coarse_scale <= 16, "coarse_scale must be in [1, 16] (1 = off)");
   require(fine_iterations >= 1 && fine_iterations <= 100, "fine_iterations must be in [1, 100]");
-  require(std::isfinite(fine_refine_range) && fine_refine_range > 0, "fine_refine_range must be > 0");
-  require(num_threads >= 0 && num_threads <= 256, "num_threads must be in [0, 256] (0 = all cores)");
+  require(std::isfinite(fine_refine_range) && fine_refine_range > 0,
+          "fine_refine_range must be > 0");
+  require(num_threads >= 0 && num_threads <= 256,
+          "num_threads must be in [0, 256] (0 = all cores)");
 }
 
-/// Per-object buffers reused across frames (a fresh full-size buffer costs page faults every frame).
+/// Per-object buffers reused across frames (a fresh full-size buffer costs page faults every
+/// frame).
 struct PatchMatchStereo::Scratch {
   patchmatch::ViewState left, right;
 };
@@ -110,8 +113,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   // propagation and the left-right check; view propagation runs around its sweeps (left -> right
   // before, right -> left after), since in the other iterations the right view would only hand
   // the left view's own planes back.
-  const int right_iterations = p.right_iterations < 0 ? iterations
-                                                      : std::min(p.right_iterations, iterations);
+  const int right_iterations =
+      p.right_iterations < 0 ? iterations : std::min(p.right_iterations, iterations);
   for (int it = 0; it < iterations; ++it) {
     sweep(left_search, lv, p, it);
     if (!two_views || it < iterations - right_iterations) continue;
@@ -128,9 +131,9 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     result.right_planes = planeMap(rv);
   }
   if (p.lr_check) {
-    result.inconsistent = leftRightCheck(result.disparity, result.right_disparity,
-                                         static_cast<float>(p.lr_max_diff), lv.locked,
-                                         p.confidence_weighting && !lv.prior.empty());
+    result.inconsistent =
+        leftRightCheck(result.disparity, result.right_disparity, static_cast<float>(p.lr_max_diff),
+                       lv.locked, p.confidence_weighting && !lv.prior.empty());
     fillHoles(lv, result.inconsistent.clone(), std::max(p.window_radius, 5),
               static_cast<float>(p.weight_delta), static_cast<float>(p.fill_confidence),
               result.disparity, threadCount(p));
