@@ -1,40 +1,52 @@
-// fusion_benchmark: wall time of every stage of the fusion on one KITTI frame (1242x375), median
-// over N repetitions after a warm-up run.
+// fusion_benchmark: wall time of every stage of the fusion on one frame (KITTI raw or the
+// synthetic street at any size and ring count), beside OpenCV's StereoSGBM on the same pair in
+// the same run: median over N repetitions after a warm-up, fused and SGBM alternating so that both
+// see the same machine.
 #include <omp.h>
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <iostream>
 #include <string>
 #include <vector>
 
+#include <opencv2/calib3d.hpp>
+
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
 #include "lidar_stereo_fusion/io/report.h"
+#include "lidar_stereo_fusion/sim/synthetic_frame.h"
 
 namespace lsf = lidar_stereo_fusion;
 
 namespace {
 
-const char* const kDefaultDrive = "../shared/data/kitti_raw/2011_09_26/2011_09_26_drive_0009_sync";
+const char* const kDrive = "kitti_raw/2011_09_26/2011_09_26_drive_0009_sync";
 
 const char* const kUsage = R"(Usage: fusion_benchmark [options]
 
-Times every stage of the fusion on one KITTI raw frame: one warm-up run, then --repeat runs;
-prints the median [ms] per stage and per frame.
+Times every stage of the fusion on one frame and OpenCV's StereoSGBM (MODE_SGBM_3WAY, 128
+disparities, block 5, the same thread count) on the same pair, alternating, after one warm-up
+run of each; prints the median [ms] per stage, SGBM's median and the ratio fused / SGBM (median
+of the per-repetition ratios).
 
 Options:
-  --kitti-raw <dir>  the drive (default ../shared/data/kitti_raw/2011_09_26/
-                     2011_09_26_drive_0009_sync, relative to the working folder)
-  --frame <name>     frame name, e.g. 0000000000 (default: the first frame)
+  --kitti-raw <dir>  the KITTI drive (default: the shared data's drive 0009, found from the
+                     build's data folder or env LSF_DATA_DIR)
+  --frame <name>     frame name, e.g. 0000000000 (default: the first); `all`: every frame, one
+                     line each
+  --synthetic WxH    the synthetic street at this size instead of KITTI (e.g. 1280x720)
+  --rings 64|128     LiDAR rings of the synthetic street (default 64)
   --repeat N         timed repetitions (default 5)
   --method <name>    fused_bi (default) | fused_bf | pms | lidar_bi | lidar_bf
-  --threads N        OpenMP threads (default 0 = all cores)
-  --params <yaml>    parameters; --method overrides its 'method'
+  --threads N        threads for both (default 0 = all cores)
+  --params <yaml>    parameters (e.g. config/paper.yaml); --method overrides its 'method'
+  --no-sgbm          skip the SGBM reference
   --help             this text
 )";
 
@@ -48,21 +60,31 @@ double timeMs(const std::function<void()>& f) {
 }
 
 struct Options {
-  std::string drive = kDefaultDrive, frame, method, params;
-  int repeat = 5, threads = 0;
-  bool help = false;
+  std::string drive, frame, method, params, synthetic;
+  int repeat = 5, threads = 0, rings = 64;
+  bool help = false, sgbm = true;
 };
 
+std::string defaultDrive() {
+  const char* env = std::getenv("LSF_DATA_DIR");
+  const std::string data = env && *env ? env : LSF_DEFAULT_DATA_DIR;
+  return data + "/" + kDrive;
+}
+
 Options parseOptions(int argc, char** argv) {
-  const lsf::CommandLine cl(
-      argc, argv, {"--kitti-raw", "--frame", "--repeat", "--method", "--threads", "--params"},
-      {"--help"});
+  const lsf::CommandLine cl(argc, argv,
+                            {"--kitti-raw", "--frame", "--repeat", "--method", "--threads",
+                             "--params", "--synthetic", "--rings"},
+                            {"--help", "--no-sgbm"});
   Options o;
   o.help = cl.has("--help");
-  o.drive = cl.value("--kitti-raw", kDefaultDrive);
+  o.sgbm = !cl.has("--no-sgbm");
+  o.drive = cl.value("--kitti-raw", defaultDrive());
   o.frame = cl.value("--frame");
+  o.synthetic = cl.value("--synthetic");
+  o.rings = std::stoi(cl.choice("--rings", "64", {"64", "128"}));
   o.repeat = cl.intValue("--repeat", 5, 1, 10000);
-  o.threads = cl.intValue("--threads", 0, 0, 1024);
+  o.threads = cl.intValue("--threads", 0, 0, 256);
   if (cl.has("--method")) {
     o.method = cl.choice("--method", "", {"fused_bi", "fused_bf", "pms", "lidar_bi", "lidar_bf"});
   }
@@ -70,101 +92,130 @@ Options parseOptions(int argc, char** argv) {
   return o;
 }
 
-lsf::kitti::Frame findFrame(const Options& o) {
-  if (!std::filesystem::is_directory(o.drive)) {
-    throw std::runtime_error("KITTI drive not found: " + o.drive +
-                             " (run from the package root next to ../shared/data, or pass "
-                             "--kitti-raw <drive_sync_dir>)");
-  }
-  const auto frames = lsf::kitti::listFrames(o.drive);
-  if (frames.empty()) throw std::runtime_error("no complete frame in " + o.drive);
-  if (o.frame.empty()) return frames.front();
-  for (const auto& f : frames) {
-    if (f.name == o.frame) return f;
-  }
-  throw std::runtime_error("frame " + o.frame + " not found in " + o.drive);
-}
-
-/// Median times [ms] of the stages inside up-sampling, measured directly on the core functions.
-struct UpsamplingDetail {
-  std::vector<double> rings, completion, removal, interpolation, bounds, bf;
+/// One input to time, with a name for the report.
+struct Case {
+  std::string name;
+  lsf::FusionInput input;
 };
 
-void timeUpsamplingDetail(const lsf::FusionInput& input, lsf::LidarCloud cloud,
-                          const lsf::FusionParams& params, UpsamplingDetail& detail) {
-  detail.rings.push_back(timeMs([&] { lsf::recoverRingsBySweepOrder(cloud); }));
-  const lsf::SparseDisparity sparse =
-      lsf::projectCloud(cloud, input.T_cam_lidar, input.camera, params.projection);
-  lsf::ScanLines lines;
-  detail.completion.push_back(timeMs([&] { lines = lsf::completeScanLines(sparse, params.bi); }));
-  detail.removal.push_back(
-      timeMs([&] { lsf::removeOccludedPoints(lines, input.left, params.bi); }));
-  detail.interpolation.push_back(
-      timeMs([&] { lsf::interpolateBetweenScanLines(lines, params.bi); }));
-  detail.bounds.push_back(
-      timeMs([&] { lsf::computeScanLineBounds(lines, params.patchmatch.bound_margin); }));
-  detail.bf.push_back(timeMs([&] { lsf::upsampleBF(sparse, params.bf); }));
+std::vector<Case> kittiCases(const Options& o) {
+  if (!std::filesystem::is_directory(o.drive)) {
+    throw std::runtime_error("KITTI drive not found: " + o.drive +
+                             " (pass --kitti-raw <drive_sync_dir> or set LSF_DATA_DIR)");
+  }
+  const auto calib = lsf::kitti::readCalibration(lsf::kitti::calibrationDirOf(o.drive));
+  const auto frames = lsf::kitti::listFrames(o.drive);
+  if (frames.empty()) throw std::runtime_error("no complete frame in " + o.drive);
+  std::vector<Case> cases;
+  for (const auto& f : frames) {
+    const bool wanted = o.frame == "all" || f.name == o.frame ||
+                        (o.frame.empty() && &f == &frames.front());
+    if (!wanted) continue;
+    const lsf::kitti::FrameData data = lsf::kitti::loadFrame(f, calib.camera);
+    cases.push_back({f.name, {data.left, data.right, data.cloud, calib.T_cam_velo, calib.camera}});
+  }
+  if (cases.empty()) throw std::runtime_error("frame " + o.frame + " not found in " + o.drive);
+  return cases;
+}
+
+Case syntheticCase(const Options& o) {
+  int w = 0, h = 0;
+  if (std::sscanf(o.synthetic.c_str(), "%dx%d", &w, &h) != 2 || w < 64 || h < 32 || w > 8192 ||
+      h > 8192) {
+    throw lsf::UsageError("--synthetic wants WxH with 64 <= W <= 8192, 32 <= H <= 8192, got '" +
+                          o.synthetic + "'");
+  }
+  lsf::sim::SyntheticParams params = lsf::sim::SyntheticParams().resized(w, h);
+  params.rings = o.rings;
+  const lsf::sim::SyntheticFrame f = lsf::sim::generateStreetFrame(params);
+  return {"synthetic " + o.synthetic + ", " + std::to_string(o.rings) + " rings",
+          {f.left, f.right, f.cloud, f.T_cam_lidar, f.camera}};
+}
+
+/// Medians of one case: pipeline stages and SGBM.
+struct Timing {
+  std::vector<lsf::FrameStats> stats;
+  std::vector<double> sgbm_ms, ratios;
+};
+
+Timing timeCase(const Case& c, lsf::FusionPipeline& pipeline, cv::StereoSGBM* sgbm, int repeat) {
+  Timing t;
+  cv::Mat sgbm_disparity;
+  pipeline.process(c.input);  // warm-up: allocations, caches
+  if (sgbm) sgbm->compute(c.input.left, c.input.right, sgbm_disparity);
+  for (int i = 0; i < repeat; ++i) {
+    t.stats.push_back(pipeline.process(c.input).stats);
+    if (!sgbm) continue;
+    t.sgbm_ms.push_back(timeMs([&] { sgbm->compute(c.input.left, c.input.right, sgbm_disparity); }));
+    t.ratios.push_back(t.stats.back().total_ms / t.sgbm_ms.back());
+  }
+  return t;
+}
+
+double medianOf(const std::vector<lsf::FrameStats>& stats, double lsf::FrameStats::*field) {
+  std::vector<double> v;
+  for (const auto& s : stats) v.push_back(s.*field);
+  return lsf::median(v);
 }
 
 void printRow(const char* name, double ms) { std::printf("| %-38s | %9.2f |\n", name, ms); }
+
+void printStages(const Timing& t) {
+  std::printf("\n| %-38s | %9s |\n|---|---|\n", "stage (median)", "ms");
+  printRow("projection (both views)", medianOf(t.stats, &lsf::FrameStats::projection_ms));
+  printRow("up-sampling + confidence (both views)",
+           medianOf(t.stats, &lsf::FrameStats::upsampling_ms));
+  printRow("PatchMatch", medianOf(t.stats, &lsf::FrameStats::patchmatch_ms));
+  printRow("depth", medianOf(t.stats, &lsf::FrameStats::depth_ms));
+  printRow("total per frame (pipeline)", medianOf(t.stats, &lsf::FrameStats::total_ms));
+  if (!t.sgbm_ms.empty()) {
+    printRow("OpenCV StereoSGBM (same pair, threads)", lsf::median(t.sgbm_ms));
+    std::printf("\nfused / SGBM = %.2f (median of %zu paired runs)\n", lsf::median(t.ratios),
+                t.ratios.size());
+  }
+  const double total = medianOf(t.stats, &lsf::FrameStats::total_ms);
+  std::printf("%.2f frames/s (pipeline median %.1f ms)\n", 1000.0 / total, total);
+}
 
 int run(const Options& o) {
   lsf::FusionParams params;
   if (!o.params.empty()) lsf::loadParamsYaml(o.params, params);
   if (!o.method.empty()) params.method = lsf::parseMethod(o.method);
   params.patchmatch.num_threads = o.threads;
-  if (o.threads > 0) omp_set_num_threads(o.threads);
+  const int threads = o.threads > 0 ? o.threads : omp_get_num_procs();
+  omp_set_num_threads(threads);
+  cv::setNumThreads(threads);
   params.validate();
 
-  const lsf::kitti::Frame frame = findFrame(o);
-  const auto calib = lsf::kitti::readCalibration(lsf::kitti::calibrationDirOf(o.drive));
-  lsf::kitti::FrameData data;
-  const double load_ms = timeMs([&] { data = lsf::kitti::loadFrame(frame, calib.camera); });
-  const lsf::FusionInput input{data.left, data.right, data.cloud, calib.T_cam_velo, calib.camera};
-  lsf::LidarCloud raw_cloud = data.cloud;
-  for (auto& p : raw_cloud) p.ring = -1;
-
-  std::printf(
-      "fusion_benchmark: frame %s (%dx%d, %zu points), method %s, %d threads, "
-      "1 warm-up + %d runs\n",
-      frame.name.c_str(), calib.camera.width, calib.camera.height, data.cloud.size(),
-      lsf::methodName(params.method).c_str(), o.threads > 0 ? o.threads : omp_get_max_threads(),
-      o.repeat);
-  lsf::FusionPipeline pipeline(params);
-  pipeline.process(input);  // warm-up: allocations, caches
-  std::vector<lsf::FrameStats> stats;
-  UpsamplingDetail detail;
-  lsf::ProgressBar progress(std::cerr, o.repeat, false);
-  for (int i = 0; i < o.repeat; ++i) {
-    stats.push_back(pipeline.process(input).stats);
-    timeUpsamplingDetail(input, raw_cloud, params, detail);
-    if (o.repeat >= 3) progress.update(i + 1, "runs");
+  const std::vector<Case> cases = o.synthetic.empty() ? kittiCases(o)
+                                                      : std::vector<Case>{syntheticCase(o)};
+  const cv::Size size = cases.front().input.left.size();
+  std::printf("fusion_benchmark: %s (%dx%d, %zu points), method %s, %d threads, 1 warm-up + %d runs\n",
+              cases.size() == 1 ? cases.front().name.c_str() : "every frame", size.width,
+              size.height, cases.front().input.cloud.size(), lsf::methodName(params.method).c_str(),
+              threads, o.repeat);
+  cv::Ptr<cv::StereoSGBM> sgbm;
+  if (o.sgbm) {
+    sgbm = cv::StereoSGBM::create(0, 128, 5, 8 * 3 * 25, 32 * 3 * 25, 1, 63, 10, 100, 32,
+                                  cv::StereoSGBM::MODE_SGBM_3WAY);
   }
-
-  auto medianOf = [&](double lsf::FrameStats::*field) {
-    std::vector<double> v;
-    for (const auto& s : stats) v.push_back(s.*field);
-    return lsf::median(v);
-  };
-  std::printf("\n| %-38s | %9s |\n|---|---|\n", "stage (median)", "ms");
-  printRow("load frame (PNG + .bin + rings, once)", load_ms);
-  printRow("projection", medianOf(&lsf::FrameStats::projection_ms));
-  printRow("up-sampling", medianOf(&lsf::FrameStats::upsampling_ms));
-  printRow("PatchMatch", medianOf(&lsf::FrameStats::patchmatch_ms));
-  printRow("depth", medianOf(&lsf::FrameStats::depth_ms));
-  printRow("total per frame (pipeline)", medianOf(&lsf::FrameStats::total_ms));
-  std::printf(
-      "\nInside the stages (core functions timed alone, one view):\n\n"
-      "| %-38s | %9s |\n|---|---|\n",
-      "function (median)", "ms");
-  printRow("ring recovery (sweep order)", lsf::median(detail.rings));
-  printRow("BI* scan-line completion", lsf::median(detail.completion));
-  printRow("BI* Algorithm 1 (occlusion removal)", lsf::median(detail.removal));
-  printRow("BI* interpolation (Eq. 3)", lsf::median(detail.interpolation));
-  printRow("scan-line search bounds", lsf::median(detail.bounds));
-  printRow("BF* bilateral up-sampling", lsf::median(detail.bf));
-  const double total = medianOf(&lsf::FrameStats::total_ms);
-  std::printf("\n%.2f frames/s (pipeline median %.1f ms)\n", 1000.0 / total, total);
+  lsf::FusionPipeline pipeline(params);
+  if (cases.size() == 1) {
+    printStages(timeCase(cases.front(), pipeline, sgbm.get(), o.repeat));
+    return 0;
+  }
+  std::printf("\n| frame | fused ms | PatchMatch ms | SGBM ms | fused / SGBM |\n|---|---|---|---|---|\n");
+  std::vector<double> ratios;
+  for (const Case& c : cases) {
+    const Timing t = timeCase(c, pipeline, sgbm.get(), o.repeat);
+    const double r = t.ratios.empty() ? 0.0 : lsf::median(t.ratios);
+    ratios.push_back(r);
+    std::printf("| %s | %.1f | %.1f | %.1f | %.2f |\n", c.name.c_str(),
+                medianOf(t.stats, &lsf::FrameStats::total_ms),
+                medianOf(t.stats, &lsf::FrameStats::patchmatch_ms),
+                t.sgbm_ms.empty() ? 0.0 : lsf::median(t.sgbm_ms), r);
+  }
+  std::printf("\nmedian fused / SGBM over %zu frames: %.2f\n", cases.size(), lsf::median(ratios));
   return 0;
 }
 
@@ -184,6 +235,9 @@ int main(int argc, char** argv) {
   }
   try {
     return run(options);
+  } catch (const lsf::UsageError& e) {
+    std::cerr << "fusion_benchmark: " << e.what() << "\n\n" << kUsage;
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "fusion_benchmark: error: " << e.what() << "\n";
     return 1;
