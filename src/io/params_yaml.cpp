@@ -82,6 +82,8 @@ void visitPatchMatch(P& p, V& v) {
   v("lock_confidence", p.lock_confidence);
   v("fill_confidence", p.fill_confidence);
   v("coarse_scale", p.coarse_scale);
+  v("coarse_levels", p.coarse_levels);
+  v("full_size_unbounded", p.full_size_unbounded);
   v("fine_iterations", p.fine_iterations);
   v("fine_refine_range", p.fine_refine_range);
   v("num_threads", p.num_threads);

@@ -67,6 +67,8 @@ void visitParams(FusionParams& p, Visitor&& v) {
   v("patchmatch", "lock_confidence", m.lock_confidence);
   v("patchmatch", "fill_confidence", m.fill_confidence);
   v("patchmatch", "coarse_scale", m.coarse_scale);
+  v("patchmatch", "coarse_levels", m.coarse_levels);
+  v("patchmatch", "full_size_unbounded", m.full_size_unbounded);
   v("patchmatch", "fine_iterations", m.fine_iterations);
   v("patchmatch", "fine_refine_range", m.fine_refine_range);
   v("patchmatch", "num_threads", m.num_threads);

@@ -70,7 +70,9 @@ FusionParams everyFieldChanged() {
   m.confidence_weighting = false;
   m.lock_confidence = 0.75;
   m.fill_confidence = 0.25;
-  m.coarse_scale = 2;
+  m.coarse_scale = 3;
+  m.coarse_levels = 3;
+  m.full_size_unbounded = true;
   m.fine_iterations = 2;
   m.fine_refine_range = 1.5;
   p.confidence.edge_tolerance = 0.25;
@@ -125,6 +127,8 @@ void expectSame(const FusionParams& a, const FusionParams& b) {
   EXPECT_EQ(x.lock_confidence, y.lock_confidence);
   EXPECT_EQ(x.fill_confidence, y.fill_confidence);
   EXPECT_EQ(x.coarse_scale, y.coarse_scale);
+  EXPECT_EQ(x.coarse_levels, y.coarse_levels);
+  EXPECT_EQ(x.full_size_unbounded, y.full_size_unbounded);
   EXPECT_EQ(x.fine_iterations, y.fine_iterations);
   EXPECT_EQ(x.fine_refine_range, y.fine_refine_range);
   const PriorConfidenceParams &c = a.confidence, &d = b.confidence;

@@ -246,6 +246,30 @@ TEST(PatchMatchPostProcessing, ConfidentPriorFillsElseTheBackgroundNeighbour) {
   EXPECT_EQ(disparity(0, 0), 12.f);
 }
 
+TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {
+  lsf::PatchMatchParams p = params3x3();
+  lsf::ScanLineBounds b;
+  b.lo = cv::Mat1f::zeros(4, 6);
+  b.hi = cv::Mat1f::zeros(4, 6);
+  b.range = cv::Mat1f::zeros(4, 6);
+  for (int x = 0; x < 6; ++x) b.hi(2, x) = b.lo(2, x) = 5.f;  // row 2 lies between scan lines
+  cv::Mat1f prior = cv::Mat1f::zeros(4, 6), conf = cv::Mat1f::zeros(4, 6);
+  prior(3, 0) = 5.f;
+  conf(3, 0) = 1.f;  // one pixel locked to the prior
+  Views v = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
+  pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, v.left);
+  EXPECT_EQ(v.left.locked[0 * 6 + 1], pm::kSettledByGuide);
+  EXPECT_EQ(v.left.locked[2 * 6 + 1], 0);  // bounded: searched
+  EXPECT_EQ(v.left.locked[3 * 6 + 0], pm::kLockedToPrior);
+  const pm::PlaneSearch search(p, v.left, v.right);
+  pm::Rng rng(3);
+  EXPECT_EQ(search.initialPlane(1, 0, rng).c, 7.f);
+  p.full_size_unbounded = true;
+  Views w = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
+  pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, w.left);
+  EXPECT_EQ(w.left.locked[0 * 6 + 1], 0);
+}
+
 TEST(PatchMatchCoarseStart, PlanesScaleToFullSizeAndViewsReduceExactly) {
   cv::Mat3f coarse(2, 3, cv::Vec3f(0.f, 0.f, 0.f));
   coarse(1, 2) = cv::Vec3f(0.5f, 0.25f, 3.f);
@@ -262,10 +286,20 @@ TEST(PatchMatchCoarseStart, PlanesScaleToFullSizeAndViewsReduceExactly) {
   EXPECT_EQ(small.confidence(1, 1), 0.75f);
   lsf::PatchMatchParams params;
   params.coarse_scale = 4;
+  params.coarse_levels = 1;
   const lsf::PatchMatchParams c = pm::coarseParams(params);
   EXPECT_EQ(c.window_radius, 2);
   EXPECT_EQ(c.window_stride, 1);
   EXPECT_EQ(c.max_disparity, params.max_disparity / 4);
   EXPECT_EQ(c.coarse_scale, 1);
   EXPECT_FALSE(c.lr_check);
+  // Two levels of 2: the level below is itself a coarse start of one level.
+  params.coarse_scale = 2;
+  params.coarse_levels = 2;
+  const lsf::PatchMatchParams half = pm::coarseParams(params);
+  EXPECT_EQ(half.window_radius, 4);
+  EXPECT_EQ(half.coarse_scale, 2);
+  EXPECT_EQ(half.coarse_levels, 1);
+  EXPECT_TRUE(half.full_size_unbounded);
+  EXPECT_EQ(pm::coarseParams(half).window_radius, 2);
 }

@@ -55,10 +55,16 @@ struct PatchMatchParams {
   double lock_confidence = 0.5;
   /// Inconsistent pixels (left-right check) take the prior where its confidence is >= this.
   double fill_confidence = 0.5;
-  /// Coarse start (patchmatch/coarse_to_fine.h): the search first runs on images reduced by this
-  /// factor (1 = off), then `fine_iterations` sweeps at full size start from its planes, refining
-  /// unbounded pixels from +-fine_refine_range instead of half the image's disparity range.
-  int coarse_scale = 4;
+  /// Coarse start (patchmatch/coarse_to_fine.h): the search first runs on images reduced by
+  /// coarse_scale^coarse_levels (1 = off), then at each larger level `fine_iterations` sweeps start
+  /// from the planes of the level below, refining unbounded pixels from +-fine_refine_range
+  /// instead of half the image's disparity range.
+  int coarse_scale = 2;
+  int coarse_levels = 2;
+  /// Whether the pixels without scan-line bounds (no LiDAR above and below) are searched at full
+  /// size too; false: they keep the plane of the level below (half size), which is where most of
+  /// the time of a frame with sky and facades above the LiDAR would go.
+  bool full_size_unbounded = false;
   int fine_iterations = 1;
   double fine_refine_range = 2.0;  ///< [px]
   int num_threads = 0;           ///< 0 = all cores (at most 256)

@@ -54,7 +54,9 @@ PatchMatchParams coarseParams(const PatchMatchParams& p) {
   c.max_disparity = p.max_disparity / s;
   c.min_refine_range = p.min_refine_range / s;
   c.lr_check = false;
-  c.coarse_scale = 1;
+  c.coarse_levels = std::max(1, p.coarse_levels - 1);
+  c.coarse_scale = p.coarse_levels > 1 ? s : 1;
+  c.full_size_unbounded = true;  // the levels below search everything
   return c;
 }
 

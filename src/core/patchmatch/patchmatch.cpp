@@ -25,6 +25,13 @@ void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument("PatchMatchParams: " + message);
 }
 
+/// 1 where the pixel's plane is the prior's (the left-right check keeps those), else 0.
+std::vector<uint8_t> lockedToPrior(const patchmatch::ViewState& v) {
+  std::vector<uint8_t> keep(v.locked.size());
+  for (size_t i = 0; i < keep.size(); ++i) keep[i] = v.locked[i] == patchmatch::kLockedToPrior;
+  return keep;
+}
+
 cv::Mat3f planeMap(const patchmatch::ViewState& v) {
   cv::Mat3f map(v.height, v.width);
   for (int y = 0; y < v.height; ++y) {
@@ -60,6 +67,7 @@ void PatchMatchParams::validate() const {
           "lock_confidence must be >= 0 (> 1 = never lock)");
   require(fill_confidence >= 0 && fill_confidence <= 1, "fill_confidence must be in [0, 1]");
   require(coarse_scale >= 1 && coarse_scale <= 16, "coarse_scale must be in [1, 16] (1 = off)");
+  require(coarse_levels >= 1 && coarse_levels <= 4, "coarse_levels must be in [1, 4]");
   require(fine_iterations >= 1 && fine_iterations <= 100, "fine_iterations must be in [1, 100]");
   require(std::isfinite(fine_refine_range) && fine_refine_range > 0,
           "fine_refine_range must be > 0");
@@ -100,8 +108,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     coarse_->setParams(coarseParams(p));
     const PatchMatchResult coarse = coarse_->compute(downsampleView(left, p.coarse_scale),
                                                      downsampleView(right, p.coarse_scale));
-    lv.guide = upsamplePlanes(coarse.planes, p.coarse_scale, size);
-    if (two_views) rv.guide = upsamplePlanes(coarse.right_planes, p.coarse_scale, size);
+    setGuide(upsamplePlanes(coarse.planes, p.coarse_scale, size), p, lv);
+    if (two_views) setGuide(upsamplePlanes(coarse.right_planes, p.coarse_scale, size), p, rv);
     iterations = p.fine_iterations;
   }
 
@@ -133,7 +141,7 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   if (p.lr_check) {
     result.inconsistent =
         leftRightCheck(result.disparity, result.right_disparity, static_cast<float>(p.lr_max_diff),
-                       lv.locked, p.confidence_weighting && !lv.prior.empty());
+                       lockedToPrior(lv), p.confidence_weighting && !lv.prior.empty());
     fillHoles(lv, result.inconsistent.clone(), std::max(p.window_radius, 5),
               static_cast<float>(p.weight_delta), static_cast<float>(p.fill_confidence),
               result.disparity, threadCount(p));

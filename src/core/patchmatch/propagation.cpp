@@ -31,7 +31,8 @@ void PlaneSearch::initRange(int x, int y, float& lo, float& hi) const {
 
 Plane PlaneSearch::initialPlane(int x, int y, Rng& rng) const {
   const int idx = y * self_.width + x;
-  if (self_.isLocked(idx)) return priorPlane(self_, x, y);
+  if (self_.locked[idx] == kLockedToPrior) return priorPlane(self_, x, y);
+  if (self_.locked[idx] == kSettledByGuide) return self_.guide[idx];
   if (!self_.guide.empty()) {
     const Plane& g = self_.guide[idx];
     if (admissible(x, y, g.at(static_cast<float>(x), static_cast<float>(y)))) return g;
@@ -72,7 +73,11 @@ void PlaneSearch::randomNormal(Rng& rng, float& nx, float& ny, float& nz) const 
 void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
                                WindowCache& cache) const {
   const int idx = y * self_.width + x;
-  if (self_.isLocked(idx)) return;
+  if (self_.locked[idx] == kLockedToPrior) return;
+  if (self_.locked[idx] == kSettledByGuide) {
+    if (self_.match_sign < 0) polishSettled(x, y, idx, cache);
+    return;
+  }
   cost_.buildWindow(x, y, cache);
   Plane best = self_.planes[idx];
   float best_cost = currentCost(idx, cache);
@@ -85,6 +90,19 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   }
   Rng rng(streamKey(p_.seed, self_.match_sign < 0 ? 0 : 1, iteration, idx));
   refine(x, y, cache, rng, best, best_cost);
+  self_.planes[idx] = best;
+  self_.cost[idx] = best_cost;
+}
+
+void PlaneSearch::polishSettled(int x, int y, int idx, WindowCache& cache) const {
+  cost_.buildWindow(x, y, cache);
+  Plane best = self_.planes[idx];
+  float best_cost = currentCost(idx, cache);
+  const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+  for (const float step : {kPolishStep, -kPolishStep, 0.5f * kPolishStep, -0.5f * kPolishStep}) {
+    const Plane candidate{best.a, best.b, best.c + step};
+    if (admissible(x, y, candidate.at(fx, fy))) tryPlane(x, y, candidate, cache, best, best_cost);
+  }
   self_.planes[idx] = best;
   self_.cost[idx] = best_cost;
 }

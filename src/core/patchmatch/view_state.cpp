@@ -139,7 +139,18 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
   if (v.trust.empty() || !p.confidence_weighting || lock > 1.f) return;
   for (int y = 0; y < v.height; ++y) {
     const float* t = v.trust[y];
-    for (int x = 0; x < v.width; ++x) v.locked[y * v.width + x] = t[x] >= lock ? 1 : 0;
+    for (int x = 0; x < v.width; ++x) v.locked[y * v.width + x] = t[x] >= lock ? kLockedToPrior : 0;
+  }
+}
+
+void setGuide(std::vector<Plane> guide, const PatchMatchParams& p, ViewState& v) {
+  v.guide = std::move(guide);
+  if (p.full_size_unbounded) return;
+  for (int y = 0; y < v.height; ++y) {
+    for (int x = 0; x < v.width; ++x) {
+      uint8_t& l = v.locked[y * v.width + x];
+      if (l == 0 && !v.bounded(x, y)) l = kSettledByGuide;
+    }
   }
 }
 

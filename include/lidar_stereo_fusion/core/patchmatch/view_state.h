@@ -14,6 +14,9 @@
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
+constexpr uint8_t kLockedToPrior = 1;
+constexpr uint8_t kSettledByGuide = 2;
+
 struct ViewState {
   int width = 0, height = 0;
   float match_sign = -1.f;  ///< the match of x is at x + sign * d in the other view
@@ -27,7 +30,9 @@ struct ViewState {
   float d_min = 0.f, d_max = 0.f;  ///< the image's disparity range [px]
   std::vector<Plane> planes;
   std::vector<float> cost;
-  /// 1 where the plane is the prior's and is not searched (trust >= lock_confidence).
+  /// Pixels that are not searched: kLockedToPrior where the plane is the prior's (trust >=
+  /// lock_confidence), kSettledByGuide where it is the coarse level's (no scan-line bounds and
+  /// full_size_unbounded false); 0 elsewhere.
   std::vector<uint8_t> locked;
   /// Planes of the coarse start, up-sampled (empty: none): the initial plane where admissible.
   std::vector<Plane> guide;
@@ -38,6 +43,10 @@ struct ViewState {
 
 /// Fills `v` from one view's input (reusing its buffers). match_sign: -1 left, +1 right.
 void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sign, ViewState& v);
+
+/// Sets the coarse level's planes as `v`'s guide and, unless full_size_unbounded, settles the
+/// pixels without scan-line bounds that are not locked to the prior: they keep the guide's plane.
+void setGuide(std::vector<Plane> guide, const PatchMatchParams& p, ViewState& v);
 
 /// Throws std::invalid_argument naming the problem when a view's input does not fit `size`.
 void checkViewInput(const ViewInput& v, const cv::Size& size, const char* which);
