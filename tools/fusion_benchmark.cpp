@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
@@ -125,11 +126,11 @@ int run(const Options& o) {
   for (auto& p : raw_cloud) p.ring = -1;
 
   std::printf(
-      "fusion_benchmark: frame %s (%dx%d, %zu points), method %s, %d threads, "
+      "fusion_benchmark: frame %s (%dx%d, %zu points), method %s, %d threads, SIMD %s, "
       "1 warm-up + %d runs\n",
       frame.name.c_str(), calib.camera.width, calib.camera.height, data.cloud.size(),
       lsf::methodName(params.method).c_str(), o.threads > 0 ? o.threads : omp_get_max_threads(),
-      o.repeat);
+      lsf::simdLevel(), o.repeat);
   lsf::FusionPipeline pipeline(params);
   pipeline.process(input);  // warm-up: allocations, caches
   std::vector<lsf::FrameStats> stats;

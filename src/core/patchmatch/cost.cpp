@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 
 namespace lidar_stereo_fusion {
 namespace patchmatch {
@@ -10,6 +13,8 @@ namespace patchmatch {
 void WindowCache::reserve(size_t n) {
   for (auto* v : {&xs, &ys, &w_img, &w_lidar, &c0, &c1, &c2, &g0, &g1, &priors}) v->assign(n, 0.f);
   row_offset.assign(n, 0);
+  texels.assign(n * kTexelFloats, 0.f);
+  texel_row.assign(n, 0);
 }
 
 MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self,
@@ -33,6 +38,10 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   use_prior_ = wg_ > 0.f && !self_.prior.empty();
   weighted_ = p_.confidence_weighting;
   img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
+  avx2_ = activeSimdPath() == SimdPath::kAvx2 && !self_.texels.empty() && !other_.texels.empty();
+  const float x_max = static_cast<float>(self_.width - 1);
+  kernel_ = KernelConstants{other_.texels.data(), x_max, x_max - 1e-3f, self_.match_sign, wa_,
+                            use_grad_ ? wb_ : 0.f, lcol_, lgrad_, ldisp_, outside_cost_};
 }
 
 float MatchingCost::supportWeight(float l1) const {
@@ -40,12 +49,13 @@ float MatchingCost::supportWeight(float l1) const {
 }
 
 void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
-  const size_t n = offsets_.size() * offsets_.size();
+  const size_t n = offsets_.size() * offsets_.size() + kSimdBlock;  // room for the padding
   if (cache.xs.size() < n) cache.reserve(n);
   cache.constant = 0.f;
   int k = 0;
   const cv::Vec3f center = self_.color(py, px);
   const int color_stride = 3 * other_.width;
+  const int texel_stride = kTexelFloats * other_.width;
   for (int dy : offsets_) {
     const int y = py + dy;
     if (y < 0 || y >= self_.height) continue;
@@ -61,13 +71,19 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
                                     std::abs(c[2] - center[2]));
       cache.xs[k] = static_cast<float>(x);
       cache.ys[k] = static_cast<float>(y);
-      cache.c0[k] = c[0];
-      cache.c1[k] = c[1];
-      cache.c2[k] = c[2];
-      cache.row_offset[k] = y * color_stride;
-      if (use_grad_) {
-        cache.g0[k] = grow[x][0];
-        cache.g1[k] = grow[x][1];
+      if (avx2_) {
+        std::memcpy(&cache.texels[k * kTexelFloats], &self_.texels[(y * self_.width + x) * kTexelFloats],
+                    kTexelFloats * sizeof(float));
+        cache.texel_row[k] = y * texel_stride;
+      } else {
+        cache.c0[k] = c[0];
+        cache.c1[k] = c[1];
+        cache.c2[k] = c[2];
+        cache.row_offset[k] = y * color_stride;
+        if (use_grad_) {
+          cache.g0[k] = grow[x][0];
+          cache.g1[k] = grow[x][1];
+        }
       }
       const float trust = use_prior_ ? trow[x] : 0.f;
       cache.priors[k] = use_prior_ ? prow[x] : 0.f;
@@ -86,9 +102,33 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
     }
   }
   cache.count = k;
+  cache.padded = k;
+  if (avx2_) fillSimdWindow(cache);
+}
+
+void MatchingCost::fillSimdWindow(WindowCache& cache) const {
+  // Padding: zero-weight samples at the first sample's position (their match is inside the
+  // image's rows, their terms are finite and contribute exactly 0).
+  const int padded = (cache.count + kSimdBlock - 1) / kSimdBlock * kSimdBlock;
+  for (int k = cache.count; k < padded; ++k) {
+    cache.xs[k] = cache.xs[0];
+    cache.ys[k] = cache.ys[0];
+    cache.w_img[k] = 0.f;
+    cache.w_lidar[k] = 0.f;
+    cache.priors[k] = 0.f;
+    cache.texel_row[k] = cache.texel_row[0];
+    std::fill_n(&cache.texels[k * kTexelFloats], kTexelFloats, 0.f);
+  }
+  cache.padded = padded;
 }
 
 float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, float bound) const {
+  if (avx2_) {
+    const KernelWindow w{cache.xs.data(),     cache.ys.data(),     cache.w_img.data(),
+                         cache.w_lidar.data(), cache.priors.data(), cache.texels.data(),
+                         cache.texel_row.data(), cache.padded,     cache.constant};
+    return aggregateAvx2(w, kernel_, plane.a, plane.b, plane.c, bound);
+  }
   return use_grad_ ? aggregateImpl<true>(cache, plane, bound)
                    : aggregateImpl<false>(cache, plane, bound);
 }

@@ -1,0 +1,119 @@
+// PatchMatch: the matching cost C(p, xi) (cost.h) with AVX2 + FMA, 8 window samples at a time.
+// Compiled with -mavx2 -mfma (CMakeLists.txt) and run only where the CPU has both (simd.h).
+// Includes nothing but intrinsics and the plain-data kernel interface (see cost_kernel.h).
+//
+// Per block of 8 samples: the disparity d, the match x_q and its interpolation weight f are
+// computed as vectors; then, per sample, the two texels around x_q (B, G, R, 0, gx, gy, 0, 0) are
+// loaded as two 8-float vectors, interpolated with one FMA and compared with the sample's own
+// texel; a tree of horizontal adds turns the 8 per-sample difference vectors into the colour L1
+// and gradient L1 of the 8 samples, in the scalar code's order of summation.
+#include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
+
+#if defined(__AVX2__) && defined(__FMA__)
+
+#include <immintrin.h>
+
+namespace lidar_stereo_fusion {
+namespace patchmatch {
+
+const bool kAvx2KernelBuilt = true;
+
+namespace {
+
+/// Sum of the 8 lanes.
+inline float horizontalSum(__m256 v) {
+  __m128 s = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  s = _mm_add_ps(s, _mm_movehl_ps(s, s));
+  s = _mm_add_ss(s, _mm_movehdup_ps(s));
+  return _mm_cvtss_f32(s);
+}
+
+/// |own - interpolated| per texel channel of one sample; `t` the left node's texel, f in [0, 1).
+inline __m256 texelDifference(const float* t, const float* f, const float* own, __m256 abs_mask) {
+  const __m256 t0 = _mm256_loadu_ps(t);
+  const __m256 t1 = _mm256_loadu_ps(t + kTexelFloats);
+  const __m256 m = _mm256_fmadd_ps(_mm256_broadcast_ss(f), _mm256_sub_ps(t1, t0), t0);
+  return _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(own), m));
+}
+
+/// Colour L1 (out: col) and gradient L1 (out: grad) of 8 samples from their per-channel
+/// differences D_k = (dB, dG, dR, 0, dgx, dgy, 0, 0): (dB + dG) + dR and dgx + dgy, as scalar.
+inline void channelSums(const __m256* dk, __m256& col, __m256& grad) {
+  const __m256 h01 = _mm256_hadd_ps(dk[0], dk[1]);
+  const __m256 h23 = _mm256_hadd_ps(dk[2], dk[3]);
+  const __m256 h45 = _mm256_hadd_ps(dk[4], dk[5]);
+  const __m256 h67 = _mm256_hadd_ps(dk[6], dk[7]);
+  const __m256 s0123 = _mm256_hadd_ps(h01, h23);  // colour of 0..3 | gradient of 0..3
+  const __m256 s4567 = _mm256_hadd_ps(h45, h67);
+  col = _mm256_permute2f128_ps(s0123, s4567, 0x20);
+  grad = _mm256_permute2f128_ps(s0123, s4567, 0x31);
+}
+
+}  // namespace
+
+float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b, float c,
+                    float bound) {
+  float sum = w.constant;
+  if (sum >= bound) return sum;
+  const __m256 va = _mm256_set1_ps(a), vb = _mm256_set1_ps(b), vc = _mm256_set1_ps(c);
+  const __m256 sign = _mm256_set1_ps(k.sign), zero = _mm256_setzero_ps();
+  const __m256 x_max = _mm256_set1_ps(k.x_max), x_clamp = _mm256_set1_ps(k.x_clamp);
+  const __m256 alpha = _mm256_set1_ps(k.alpha), beta = _mm256_set1_ps(k.beta);
+  const __m256 lcol = _mm256_set1_ps(k.lambda_col), lgrad = _mm256_set1_ps(k.lambda_grad);
+  const __m256 ldisp = _mm256_set1_ps(k.lambda_disp), outside = _mm256_set1_ps(k.outside_cost);
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  alignas(32) int offset[kSimdBlock];
+  alignas(32) float frac[kSimdBlock];
+  __m256 acc = zero;
+  for (int s = 0; s < w.count; s += kSimdBlock) {
+    const __m256 x = _mm256_loadu_ps(w.xs + s);
+    const __m256 d = _mm256_add_ps(_mm256_fmadd_ps(va, x, _mm256_mul_ps(vb, _mm256_loadu_ps(w.ys + s))), vc);
+    const __m256 xm_raw = _mm256_fmadd_ps(sign, d, x);
+    const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(xm_raw, zero, _CMP_GE_OQ),
+                                        _mm256_cmp_ps(xm_raw, x_max, _CMP_LE_OQ));
+    const __m256 xm = _mm256_min_ps(_mm256_max_ps(xm_raw, zero), x_clamp);
+    const __m256i i0 = _mm256_cvttps_epi32(xm);
+    _mm256_store_ps(frac, _mm256_sub_ps(xm, _mm256_cvtepi32_ps(i0)));
+    const __m256i row = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(w.texel_row + s));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(offset),
+                       _mm256_add_epi32(row, _mm256_slli_epi32(i0, 3)));
+    __m256 dk[kSimdBlock];
+    const float* own = w.texels + s * kTexelFloats;
+    for (int j = 0; j < kSimdBlock; ++j) {
+      dk[j] = texelDifference(k.other_texels + offset[j], frac + j, own + j * kTexelFloats,
+                              abs_mask);
+    }
+    __m256 col, grad;
+    channelSums(dk, col, grad);
+    __m256 rho_img = _mm256_fmadd_ps(alpha, _mm256_min_ps(col, lcol),
+                                     _mm256_mul_ps(beta, _mm256_min_ps(grad, lgrad)));
+    rho_img = _mm256_blendv_ps(outside, rho_img, inside);
+    const __m256 lid_diff = _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(w.priors + s), d));
+    const __m256 rho_lid = _mm256_min_ps(lid_diff, ldisp);
+    acc = _mm256_fmadd_ps(_mm256_loadu_ps(w.w_img + s), rho_img,
+                          _mm256_fmadd_ps(_mm256_loadu_ps(w.w_lidar + s), rho_lid, acc));
+    // Early exit: every term is >= 0, so a partial sum above the bound stays above it.
+    const float partial = sum + horizontalSum(acc);
+    if (partial >= bound) return partial;
+  }
+  return sum + horizontalSum(acc);
+}
+
+}  // namespace patchmatch
+}  // namespace lidar_stereo_fusion
+
+#else  // no AVX2 + FMA in this build (non-x86): never selected, see simd.cpp
+
+namespace lidar_stereo_fusion {
+namespace patchmatch {
+
+const bool kAvx2KernelBuilt = false;
+
+float aggregateAvx2(const KernelWindow& w, const KernelConstants&, float, float, float, float) {
+  return w.constant;
+}
+
+}  // namespace patchmatch
+}  // namespace lidar_stereo_fusion
+
+#endif
