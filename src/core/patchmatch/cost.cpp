@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include "lidar_stereo_fusion/core/patchmatch/simd.h"
 
@@ -40,6 +39,23 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
   avx2_ = activeSimdPath() == SimdPath::kAvx2 && !self_.texels.empty() && !other_.texels.empty();
   const float x_max = static_cast<float>(self_.width - 1);
+  kernel_self_ = KernelSelf{self_.texels.data(),
+                            use_prior_ ? self_.prior.ptr<float>(0) : nullptr,
+                            use_prior_ ? self_.trust.ptr<float>(0) : nullptr,
+                            use_prior_ ? static_cast<int>(self_.prior.step1()) : 0,
+                            use_prior_ ? static_cast<int>(self_.trust.step1()) : 0,
+                            self_.width,
+                            self_.height,
+                            kTexelFloats * other_.width,
+                            offsets_.data(),
+                            static_cast<int>(offsets_.size()),
+                            weight_lut_.data(),
+                            kLutSize,
+                            kLutScale,
+                            weighted_,
+                            wg_,
+                            img_norm_,
+                            ldisp_};
   kernel_ = KernelConstants{other_.texels.data(), x_max, x_max - 1e-3f, self_.match_sign, wa_,
                             use_grad_ ? wb_ : 0.f, lcol_, lgrad_, ldisp_, outside_cost_};
 }
@@ -51,11 +67,17 @@ float MatchingCost::supportWeight(float l1) const {
 void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
   const size_t n = offsets_.size() * offsets_.size() + kSimdBlock;  // room for the padding
   if (cache.xs.size() < n) cache.reserve(n);
+  if (avx2_) {
+    const KernelWindowOut out{cache.xs.data(),      cache.ys.data(),     cache.w_img.data(),
+                              cache.w_lidar.data(), cache.priors.data(), cache.texels.data(),
+                              cache.texel_row.data()};
+    cache.count = buildWindowAvx2(kernel_self_, px, py, out, cache.padded, cache.constant);
+    return;
+  }
   cache.constant = 0.f;
   int k = 0;
   const cv::Vec3f center = self_.color(py, px);
   const int color_stride = 3 * other_.width;
-  const int texel_stride = kTexelFloats * other_.width;
   for (int dy : offsets_) {
     const int y = py + dy;
     if (y < 0 || y >= self_.height) continue;
@@ -71,19 +93,13 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
                                     std::abs(c[2] - center[2]));
       cache.xs[k] = static_cast<float>(x);
       cache.ys[k] = static_cast<float>(y);
-      if (avx2_) {
-        std::memcpy(&cache.texels[k * kTexelFloats], &self_.texels[(y * self_.width + x) * kTexelFloats],
-                    kTexelFloats * sizeof(float));
-        cache.texel_row[k] = y * texel_stride;
-      } else {
-        cache.c0[k] = c[0];
-        cache.c1[k] = c[1];
-        cache.c2[k] = c[2];
-        cache.row_offset[k] = y * color_stride;
-        if (use_grad_) {
-          cache.g0[k] = grow[x][0];
-          cache.g1[k] = grow[x][1];
-        }
+      cache.c0[k] = c[0];
+      cache.c1[k] = c[1];
+      cache.c2[k] = c[2];
+      cache.row_offset[k] = y * color_stride;
+      if (use_grad_) {
+        cache.g0[k] = grow[x][0];
+        cache.g1[k] = grow[x][1];
       }
       const float trust = use_prior_ ? trow[x] : 0.f;
       cache.priors[k] = use_prior_ ? prow[x] : 0.f;
@@ -103,23 +119,6 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
   }
   cache.count = k;
   cache.padded = k;
-  if (avx2_) fillSimdWindow(cache);
-}
-
-void MatchingCost::fillSimdWindow(WindowCache& cache) const {
-  // Padding: zero-weight samples at the first sample's position (their match is inside the
-  // image's rows, their terms are finite and contribute exactly 0).
-  const int padded = (cache.count + kSimdBlock - 1) / kSimdBlock * kSimdBlock;
-  for (int k = cache.count; k < padded; ++k) {
-    cache.xs[k] = cache.xs[0];
-    cache.ys[k] = cache.ys[0];
-    cache.w_img[k] = 0.f;
-    cache.w_lidar[k] = 0.f;
-    cache.priors[k] = 0.f;
-    cache.texel_row[k] = cache.texel_row[0];
-    std::fill_n(&cache.texels[k * kTexelFloats], kTexelFloats, 0.f);
-  }
-  cache.padded = padded;
 }
 
 float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, float bound) const {

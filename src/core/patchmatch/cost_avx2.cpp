@@ -49,7 +49,87 @@ inline void channelSums(const __m256* dk, __m256& col, __m256& grad) {
   grad = _mm256_permute2f128_ps(s0123, s4567, 0x31);
 }
 
+/// Pass 1 of buildWindowAvx2: positions, texels and priors of the samples inside the image, then
+/// the padding; the trust is parked in w_lidar. Returns the number of real samples.
+int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& out, int padded_max) {
+  int k = 0;
+  for (int i = 0; i < s.offset_count; ++i) {
+    const int y = py + s.offsets[i];
+    if (y < 0 || y >= s.height) continue;
+    const float* texel_row = s.texels + static_cast<long>(y) * s.width * kTexelFloats;
+    const float* prior_row = s.prior != nullptr ? s.prior + static_cast<long>(y) * s.prior_step : nullptr;
+    const float* trust_row = s.trust != nullptr ? s.trust + static_cast<long>(y) * s.trust_step : nullptr;
+    const float fy = static_cast<float>(y);
+    const int row = y * s.other_texel_stride;
+    for (int j = 0; j < s.offset_count; ++j) {
+      const int x = px + s.offsets[j];
+      if (x < 0 || x >= s.width) continue;
+      out.xs[k] = static_cast<float>(x);
+      out.ys[k] = fy;
+      out.texel_row[k] = row;
+      _mm256_storeu_ps(out.texels + k * kTexelFloats, _mm256_loadu_ps(texel_row + x * kTexelFloats));
+      out.priors[k] = prior_row != nullptr ? prior_row[x] : 0.f;
+      out.w_lidar[k] = trust_row != nullptr ? trust_row[x] : 0.f;
+      ++k;
+    }
+  }
+  for (int j = k; j < padded_max; ++j) {  // zero-weight padding at the first sample's position
+    out.xs[j] = out.xs[0];
+    out.ys[j] = out.ys[0];
+    out.texel_row[j] = out.texel_row[0];
+    _mm256_storeu_ps(out.texels + j * kTexelFloats, _mm256_setzero_ps());
+    out.priors[j] = 0.f;
+    out.w_lidar[j] = 0.f;
+  }
+  return k;
+}
+
 }  // namespace
+
+int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& out, int& padded,
+                    float& constant) {
+  const int n = s.offset_count * s.offset_count;
+  const int count = gatherSamples(s, px, py, out, (n + kSimdBlock - 1) / kSimdBlock * kSimdBlock);
+  padded = (count + kSimdBlock - 1) / kSimdBlock * kSimdBlock;
+  constant = 0.f;
+  const __m256 center = _mm256_loadu_ps(s.texels + (static_cast<long>(py) * s.width + px) * kTexelFloats);
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  const __m256 lut_scale = _mm256_set1_ps(s.lut_scale);
+  const __m256 lut_last = _mm256_set1_ps(static_cast<float>(s.lut_size - 1));
+  const __m256 gamma = _mm256_set1_ps(s.gamma), one = _mm256_set1_ps(1.f);
+  const __m256 img_norm = _mm256_set1_ps(s.img_norm), ldisp = _mm256_set1_ps(s.lambda_disp);
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const bool paper_constant = !s.weighted && s.prior != nullptr;
+  alignas(32) float empty_cost[kSimdBlock];
+  for (int b = 0; b < padded; b += kSimdBlock) {
+    __m256 dk[kSimdBlock];
+    for (int j = 0; j < kSimdBlock; ++j) {
+      dk[j] = _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(out.texels + (b + j) * kTexelFloats), center));
+    }
+    __m256 l1, unused;
+    channelSums(dk, l1, unused);
+    // w = LUT[min(lut_size - 1, int(l1 * lut_scale))] (l1 >= 0), 0 on the padding.
+    const __m256i index = _mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(l1, lut_scale), lut_last));
+    const __m256 valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(count - b), lane));
+    const __m256 w = _mm256_and_ps(valid, _mm256_i32gather_ps(s.weight_lut, index, 4));
+    const __m256 trust = _mm256_loadu_ps(out.w_lidar + b);
+    if (s.weighted) {  // phi = (1 - kappa) / (alpha + beta) rho_img + kappa rho_lid
+      const __m256 kappa = _mm256_mul_ps(gamma, trust);
+      _mm256_storeu_ps(out.w_img + b, _mm256_mul_ps(_mm256_mul_ps(w, _mm256_sub_ps(one, kappa)), img_norm));
+      _mm256_storeu_ps(out.w_lidar + b, _mm256_mul_ps(w, kappa));
+      continue;
+    }
+    // The paper: phi = rho_img + gamma rho_lid, or + gamma lambda_disp without a prior value.
+    const __m256 has_value = _mm256_cmp_ps(trust, _mm256_setzero_ps(), _CMP_GT_OQ);
+    const __m256 w_gamma = _mm256_mul_ps(w, gamma);
+    _mm256_storeu_ps(out.w_img + b, w);
+    _mm256_storeu_ps(out.w_lidar + b, _mm256_and_ps(has_value, w_gamma));
+    if (!paper_constant) continue;
+    _mm256_store_ps(empty_cost, _mm256_andnot_ps(has_value, _mm256_mul_ps(w_gamma, ldisp)));
+    for (int j = 0; j < kSimdBlock; ++j) constant += empty_cost[j];  // the scalar code's order
+  }
+  return count;
+}
 
 float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b, float c,
                     float bound) {
@@ -111,6 +191,13 @@ const bool kAvx2KernelBuilt = false;
 
 float aggregateAvx2(const KernelWindow& w, const KernelConstants&, float, float, float, float) {
   return w.constant;
+}
+
+int buildWindowAvx2(const KernelSelf&, int, int, const KernelWindowOut&, int& padded,
+                    float& constant) {
+  padded = 0;
+  constant = 0.f;
+  return 0;
 }
 
 }  // namespace patchmatch

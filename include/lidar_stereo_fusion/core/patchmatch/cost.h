@@ -69,8 +69,6 @@ class MatchingCost {
  private:
   template <bool kGrad>
   float aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const;
-  /// The AVX2 path's part of buildWindow: texels, texel rows and the padding.
-  void fillSimdWindow(WindowCache& cache) const;
 
   static constexpr int kLutSize = 4096;
   static constexpr float kLutScale = 4.f;  ///< LUT entries per unit of RGB L1 distance
@@ -84,6 +82,7 @@ class MatchingCost {
   bool use_grad_, use_prior_, weighted_;
   bool avx2_;
   KernelConstants kernel_;
+  KernelSelf kernel_self_;
 };
 
 }  // namespace patchmatch

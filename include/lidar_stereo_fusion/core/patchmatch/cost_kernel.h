@@ -37,6 +37,35 @@ struct KernelConstants {
   float alpha, beta, lambda_col, lambda_grad, lambda_disp, outside_cost;
 };
 
+/// What building a window reads from its own view and the cost's parameters (cost.h).
+struct KernelSelf {
+  const float* texels;        ///< the view's texels, kTexelFloats per pixel, row-major
+  const float* prior;         ///< prior disparity [px] (nullptr: no prior term)
+  const float* trust;         ///< the prior's weight [0, 1] (nullptr iff prior is)
+  int prior_step, trust_step;  ///< row steps [floats]
+  int width, height;
+  int other_texel_stride;     ///< floats per row of the other view's texels
+  const int* offsets;         ///< window offsets in x and y [px]
+  int offset_count;
+  const float* weight_lut;    ///< w by L1 colour distance times lut_scale
+  int lut_size;
+  float lut_scale;
+  bool weighted;              ///< confidence-weighted phi (else the paper's)
+  float gamma, img_norm, lambda_disp;
+};
+
+/// Where a window is written: WindowCache's arrays, with room for the padding.
+struct KernelWindowOut {
+  float *xs, *ys, *w_img, *w_lidar, *priors, *texels;
+  int* texel_row;
+};
+
+/// The window of pixel (px, py), as MatchingCost::buildWindow, padded to a multiple of
+/// kSimdBlock with zero-weight samples. Returns the number of real samples; `padded` and
+/// `constant` receive the padded count and the plane-independent part of C.
+int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& out, int& padded,
+                    float& constant);
+
 /// True when cost_avx2.cpp was compiled with AVX2 + FMA (x86 builds).
 extern const bool kAvx2KernelBuilt;
 
