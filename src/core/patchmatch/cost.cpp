@@ -56,8 +56,17 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
                             wg_,
                             img_norm_,
                             ldisp_};
-  kernel_ = KernelConstants{other_.texels.data(), x_max, x_max - 1e-3f, self_.match_sign, wa_,
-                            use_grad_ ? wb_ : 0.f, lcol_, lgrad_, ldisp_, outside_cost_};
+  kernel_ = KernelConstants{other_.texels.data(),
+                            x_max,
+                            x_max - 1e-3f,
+                            self_.match_sign,
+                            static_cast<int>(offsets_.size()),
+                            wa_,
+                            use_grad_ ? wb_ : 0.f,
+                            lcol_,
+                            lgrad_,
+                            ldisp_,
+                            outside_cost_};
 }
 
 float MatchingCost::supportWeight(float l1) const {
@@ -125,7 +134,8 @@ float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, floa
   if (avx2_) {
     const KernelWindow w{cache.xs.data(),     cache.ys.data(),     cache.w_img.data(),
                          cache.w_lidar.data(), cache.priors.data(), cache.texels.data(),
-                         cache.texel_row.data(), cache.padded,     cache.constant};
+                         cache.texel_row.data(), cache.padded,     cache.count,
+                         cache.constant};
     return aggregateAvx2(w, kernel_, plane.a, plane.b, plane.c, bound);
   }
   return use_grad_ ? aggregateImpl<true>(cache, plane, bound)

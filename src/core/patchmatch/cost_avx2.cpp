@@ -4,9 +4,11 @@
 //
 // Per block of 8 samples: the disparity d, the match x_q and its interpolation weight f are
 // computed as vectors; then, per sample, the two texels around x_q (B, G, R, 0, gx, gy, 0, 0) are
-// loaded as two 8-float vectors, interpolated with one FMA and compared with the sample's own
+// loaded as two 8-float vectors, interpolated and compared with the sample's own
 // texel; a tree of horizontal adds turns the 8 per-sample difference vectors into the colour L1
-// and gradient L1 of the 8 samples, in the scalar code's order of summation.
+// and gradient L1 of the 8 samples. Every float operation is the baseline's, in its order (no FMA
+// contraction, the sum accumulated sample by sample), so both paths give bit-identical costs and
+// PatchMatch results do not depend on the CPU.
 #include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
 
 #if defined(__AVX2__) && defined(__FMA__)
@@ -32,7 +34,7 @@ inline float horizontalSum(__m256 v) {
 inline __m256 texelDifference(const float* t, const float* f, const float* own, __m256 abs_mask) {
   const __m256 t0 = _mm256_loadu_ps(t);
   const __m256 t1 = _mm256_loadu_ps(t + kTexelFloats);
-  const __m256 m = _mm256_fmadd_ps(_mm256_broadcast_ss(f), _mm256_sub_ps(t1, t0), t0);
+  const __m256 m = _mm256_add_ps(t0, _mm256_mul_ps(_mm256_broadcast_ss(f), _mm256_sub_ps(t1, t0)));
   return _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(own), m));
 }
 
@@ -144,11 +146,15 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
   alignas(32) int offset[kSimdBlock];
   alignas(32) float frac[kSimdBlock];
-  __m256 acc = zero;
+  alignas(32) float term[kSimdBlock];
+  float part = 0.f;
+  int left_in_chunk = k.chunk;
   for (int s = 0; s < w.count; s += kSimdBlock) {
+    // Each operation as the baseline code does it (no FMA; -ffp-contract=off for this file).
     const __m256 x = _mm256_loadu_ps(w.xs + s);
-    const __m256 d = _mm256_add_ps(_mm256_fmadd_ps(va, x, _mm256_mul_ps(vb, _mm256_loadu_ps(w.ys + s))), vc);
-    const __m256 xm_raw = _mm256_fmadd_ps(sign, d, x);
+    const __m256 y = _mm256_loadu_ps(w.ys + s);
+    const __m256 d = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(va, x), _mm256_mul_ps(vb, y)), vc);
+    const __m256 xm_raw = _mm256_add_ps(x, _mm256_mul_ps(sign, d));
     const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(xm_raw, zero, _CMP_GE_OQ),
                                         _mm256_cmp_ps(xm_raw, x_max, _CMP_LE_OQ));
     const __m256 xm = _mm256_min_ps(_mm256_max_ps(xm_raw, zero), x_clamp);
@@ -165,18 +171,27 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
     }
     __m256 col, grad;
     channelSums(dk, col, grad);
-    __m256 rho_img = _mm256_fmadd_ps(alpha, _mm256_min_ps(col, lcol),
-                                     _mm256_mul_ps(beta, _mm256_min_ps(grad, lgrad)));
+    __m256 rho_img = _mm256_add_ps(_mm256_mul_ps(alpha, _mm256_min_ps(col, lcol)),
+                                   _mm256_mul_ps(beta, _mm256_min_ps(grad, lgrad)));
     rho_img = _mm256_blendv_ps(outside, rho_img, inside);
-    const __m256 lid_diff = _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(w.priors + s), d));
-    const __m256 rho_lid = _mm256_min_ps(lid_diff, ldisp);
-    acc = _mm256_fmadd_ps(_mm256_loadu_ps(w.w_img + s), rho_img,
-                          _mm256_fmadd_ps(_mm256_loadu_ps(w.w_lidar + s), rho_lid, acc));
-    // Early exit: every term is >= 0, so a partial sum above the bound stays above it.
-    const float partial = sum + horizontalSum(acc);
-    if (partial >= bound) return partial;
+    const __m256 lid = _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(w.priors + s), d));
+    const __m256 rho_lid = _mm256_min_ps(lid, ldisp);
+    _mm256_store_ps(term, _mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(w.w_img + s), rho_img),
+                                        _mm256_mul_ps(_mm256_loadu_ps(w.w_lidar + s), rho_lid)));
+    // Summed in sample order, the bound checked after every `chunk` samples and after the last:
+    // the baseline's order, so both paths return the same float.
+    const int n = w.real_count - s < kSimdBlock ? w.real_count - s : kSimdBlock;
+    for (int j = 0; j < n; ++j) {
+      part += term[j];
+      if (--left_in_chunk == 0) {
+        sum += part;
+        if (sum >= bound) return sum;
+        part = 0.f;
+        left_in_chunk = k.chunk;
+      }
+    }
   }
-  return sum + horizontalSum(acc);
+  return left_in_chunk == k.chunk ? sum : sum + part;
 }
 
 }  // namespace patchmatch

@@ -25,6 +25,7 @@ struct KernelWindow {
   const float* texels;      ///< the sample's own texel, kTexelFloats per sample
   const int* texel_row;     ///< start of the sample's row in the other view's texels [floats]
   int count;                ///< samples incl. padding, a multiple of kSimdBlock
+  int real_count;           ///< samples without the padding
   float constant;           ///< plane-independent part of C
 };
 
@@ -34,6 +35,7 @@ struct KernelConstants {
   float x_max;                ///< width - 1 [px]
   float x_clamp;              ///< largest x of the left interpolation node, < x_max
   float sign;                 ///< match of x at x + sign * d
+  int chunk;                  ///< samples between two checks of the bound (the baseline's)
   float alpha, beta, lambda_col, lambda_grad, lambda_disp, outside_cost;
 };
 
