@@ -30,8 +30,8 @@ class SimdPathGuard {
   lsf::SimdPath saved_;
 };
 
-#define SKIP_WITHOUT_AVX2()                                                              \
-  if (!lsf::cpuHasAvx2Fma()) {                                                           \
+#define SKIP_WITHOUT_AVX2()                                                               \
+  if (!lsf::cpuHasAvx2Fma()) {                                                            \
     GTEST_SKIP() << "this CPU (or build) has no AVX2 + FMA: only the baseline path runs"; \
   }
 

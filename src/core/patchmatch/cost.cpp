@@ -77,8 +77,8 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
   const size_t n = offsets_.size() * offsets_.size() + kSimdBlock;  // room for the padding
   if (cache.xs.size() < n) cache.reserve(n);
   if (avx2_) {
-    const KernelWindowOut out{cache.xs.data(),      cache.ys.data(),     cache.w_img.data(),
-                              cache.w_lidar.data(), cache.priors.data(), cache.texels.data(),
+    const KernelWindowOut out{cache.xs.data(),       cache.ys.data(),     cache.w_img.data(),
+                              cache.w_lidar.data(),  cache.priors.data(), cache.texels.data(),
                               cache.texel_row.data()};
     cache.count = buildWindowAvx2(kernel_self_, px, py, out, cache.padded, cache.constant);
     return;
@@ -132,9 +132,9 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
 
 float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, float bound) const {
   if (avx2_) {
-    const KernelWindow w{cache.xs.data(),     cache.ys.data(),     cache.w_img.data(),
-                         cache.w_lidar.data(), cache.priors.data(), cache.texels.data(),
-                         cache.texel_row.data(), cache.padded,     cache.count,
+    const KernelWindow w{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
+                         cache.w_lidar.data(),   cache.priors.data(), cache.texels.data(),
+                         cache.texel_row.data(), cache.padded,        cache.count,
                          cache.constant};
     return aggregateAvx2(w, kernel_, plane.a, plane.b, plane.c, bound);
   }
@@ -143,8 +143,7 @@ float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, floa
 }
 
 template <bool kGrad>
-float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane,
-                                  float bound) const {
+float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const {
   float sum = cache.constant;
   if (sum >= bound) return sum;
   const float x_max = static_cast<float>(self_.width - 1);

@@ -22,6 +22,8 @@ const bool kAvx2KernelBuilt = true;
 
 namespace {
 
+constexpr int kMaxOffsets = 101;  // window_radius <= 50 (PatchMatchParams::validate)
+
 /// Sum of the 8 lanes.
 inline float horizontalSum(__m256 v) {
   __m128 s = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
@@ -52,28 +54,46 @@ inline void channelSums(const __m256* dk, __m256& col, __m256& grad) {
 }
 
 /// Pass 1 of buildWindowAvx2: positions, texels and priors of the samples inside the image, then
-/// the padding; the trust is parked in w_lidar. Returns the number of real samples.
+/// the padding; the trust is parked in w_lidar. Returns the number of real samples. Per row, the
+/// positions are written 8 at a time (the arrays have kSimdBlock entries of room; what a row
+/// writes beyond its samples is overwritten by the next row or the padding).
 int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& out, int padded_max) {
+  // The offsets increase, so the columns inside the image are one range [j0, j1).
+  int j0 = 0, j1 = s.offset_count;
+  while (j0 < j1 && px + s.offsets[j0] < 0) ++j0;
+  while (j1 > j0 && px + s.offsets[j1 - 1] >= s.width) --j1;
+  const int m = j1 - j0;
+  alignas(32) float xcol[kMaxOffsets + kSimdBlock];
+  for (int j = 0; j < m + kSimdBlock; ++j) {
+    xcol[j] = j < m ? static_cast<float>(px + s.offsets[j0 + j]) : 0.f;
+  }
   int k = 0;
   for (int i = 0; i < s.offset_count; ++i) {
     const int y = py + s.offsets[i];
     if (y < 0 || y >= s.height) continue;
-    const float* texel_row = s.texels + static_cast<long>(y) * s.width * kTexelFloats;
-    const float* prior_row = s.prior != nullptr ? s.prior + static_cast<long>(y) * s.prior_step : nullptr;
-    const float* trust_row = s.trust != nullptr ? s.trust + static_cast<long>(y) * s.trust_step : nullptr;
-    const float fy = static_cast<float>(y);
-    const int row = y * s.other_texel_stride;
-    for (int j = 0; j < s.offset_count; ++j) {
-      const int x = px + s.offsets[j];
-      if (x < 0 || x >= s.width) continue;
-      out.xs[k] = static_cast<float>(x);
-      out.ys[k] = fy;
-      out.texel_row[k] = row;
-      _mm256_storeu_ps(out.texels + k * kTexelFloats, _mm256_loadu_ps(texel_row + x * kTexelFloats));
-      out.priors[k] = prior_row != nullptr ? prior_row[x] : 0.f;
-      out.w_lidar[k] = trust_row != nullptr ? trust_row[x] : 0.f;
-      ++k;
+    const __m256 fy = _mm256_set1_ps(static_cast<float>(y));
+    const __m256i row = _mm256_set1_epi32(y * s.other_texel_stride);
+    for (int q = 0; q < m; q += kSimdBlock) {
+      _mm256_storeu_ps(out.xs + k + q, _mm256_load_ps(xcol + q));
+      _mm256_storeu_ps(out.ys + k + q, fy);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.texel_row + k + q), row);
     }
+    const float* texel_row = s.texels + (static_cast<long>(y) * s.width + px) * kTexelFloats;
+    for (int j = 0; j < m; ++j) {
+      _mm256_storeu_ps(out.texels + (k + j) * kTexelFloats,
+                       _mm256_loadu_ps(texel_row + s.offsets[j0 + j] * kTexelFloats));
+    }
+    if (s.prior != nullptr) {
+      const float* prior_row = s.prior + static_cast<long>(y) * s.prior_step + px;
+      const float* trust_row = s.trust + static_cast<long>(y) * s.trust_step + px;
+      for (int j = 0; j < m; ++j) {
+        out.priors[k + j] = prior_row[s.offsets[j0 + j]];
+        out.w_lidar[k + j] = trust_row[s.offsets[j0 + j]];
+      }
+    } else {
+      for (int j = 0; j < m; ++j) out.priors[k + j] = out.w_lidar[k + j] = 0.f;
+    }
+    k += m;
   }
   for (int j = k; j < padded_max; ++j) {  // zero-weight padding at the first sample's position
     out.xs[j] = out.xs[0];
@@ -94,7 +114,8 @@ int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& 
   const int count = gatherSamples(s, px, py, out, (n + kSimdBlock - 1) / kSimdBlock * kSimdBlock);
   padded = (count + kSimdBlock - 1) / kSimdBlock * kSimdBlock;
   constant = 0.f;
-  const __m256 center = _mm256_loadu_ps(s.texels + (static_cast<long>(py) * s.width + px) * kTexelFloats);
+  const __m256 center =
+      _mm256_loadu_ps(s.texels + (static_cast<long>(py) * s.width + px) * kTexelFloats);
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
   const __m256 lut_scale = _mm256_set1_ps(s.lut_scale);
   const __m256 lut_last = _mm256_set1_ps(static_cast<float>(s.lut_size - 1));
@@ -106,18 +127,22 @@ int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& 
   for (int b = 0; b < padded; b += kSimdBlock) {
     __m256 dk[kSimdBlock];
     for (int j = 0; j < kSimdBlock; ++j) {
-      dk[j] = _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(out.texels + (b + j) * kTexelFloats), center));
+      dk[j] = _mm256_and_ps(
+          abs_mask, _mm256_sub_ps(_mm256_loadu_ps(out.texels + (b + j) * kTexelFloats), center));
     }
     __m256 l1, unused;
     channelSums(dk, l1, unused);
     // w = LUT[min(lut_size - 1, int(l1 * lut_scale))] (l1 >= 0), 0 on the padding.
-    const __m256i index = _mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(l1, lut_scale), lut_last));
-    const __m256 valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(count - b), lane));
+    const __m256i index =
+        _mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(l1, lut_scale), lut_last));
+    const __m256 valid =
+        _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(count - b), lane));
     const __m256 w = _mm256_and_ps(valid, _mm256_i32gather_ps(s.weight_lut, index, 4));
     const __m256 trust = _mm256_loadu_ps(out.w_lidar + b);
     if (s.weighted) {  // phi = (1 - kappa) / (alpha + beta) rho_img + kappa rho_lid
       const __m256 kappa = _mm256_mul_ps(gamma, trust);
-      _mm256_storeu_ps(out.w_img + b, _mm256_mul_ps(_mm256_mul_ps(w, _mm256_sub_ps(one, kappa)), img_norm));
+      _mm256_storeu_ps(out.w_img + b,
+                       _mm256_mul_ps(_mm256_mul_ps(w, _mm256_sub_ps(one, kappa)), img_norm));
       _mm256_storeu_ps(out.w_lidar + b, _mm256_mul_ps(w, kappa));
       continue;
     }
@@ -166,8 +191,8 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
     __m256 dk[kSimdBlock];
     const float* own = w.texels + s * kTexelFloats;
     for (int j = 0; j < kSimdBlock; ++j) {
-      dk[j] = texelDifference(k.other_texels + offset[j], frac + j, own + j * kTexelFloats,
-                              abs_mask);
+      dk[j] =
+          texelDifference(k.other_texels + offset[j], frac + j, own + j * kTexelFloats, abs_mask);
     }
     __m256 col, grad;
     channelSums(dk, col, grad);

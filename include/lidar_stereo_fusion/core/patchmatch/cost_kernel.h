@@ -17,16 +17,16 @@ constexpr int kSimdBlock = 8;
 
 /// One pixel's window as the kernel reads it (structure of arrays, `count` a multiple of 8).
 struct KernelWindow {
-  const float* xs;          ///< sample x [px]
-  const float* ys;          ///< sample y [px]
-  const float* w_img;       ///< w(p, p') times the image term's factor of phi (0: padding)
-  const float* w_lidar;     ///< w(p, p') times the LiDAR term's factor of phi
-  const float* priors;      ///< prior disparity [px] (0: none)
-  const float* texels;      ///< the sample's own texel, kTexelFloats per sample
-  const int* texel_row;     ///< start of the sample's row in the other view's texels [floats]
-  int count;                ///< samples incl. padding, a multiple of kSimdBlock
-  int real_count;           ///< samples without the padding
-  float constant;           ///< plane-independent part of C
+  const float* xs;       ///< sample x [px]
+  const float* ys;       ///< sample y [px]
+  const float* w_img;    ///< w(p, p') times the image term's factor of phi (0: padding)
+  const float* w_lidar;  ///< w(p, p') times the LiDAR term's factor of phi
+  const float* priors;   ///< prior disparity [px] (0: none)
+  const float* texels;   ///< the sample's own texel, kTexelFloats per sample
+  const int* texel_row;  ///< start of the sample's row in the other view's texels [floats]
+  int count;             ///< samples incl. padding, a multiple of kSimdBlock
+  int real_count;        ///< samples without the padding
+  float constant;        ///< plane-independent part of C
 };
 
 /// The other view and the cost's constants (cost.h).
@@ -41,18 +41,18 @@ struct KernelConstants {
 
 /// What building a window reads from its own view and the cost's parameters (cost.h).
 struct KernelSelf {
-  const float* texels;        ///< the view's texels, kTexelFloats per pixel, row-major
-  const float* prior;         ///< prior disparity [px] (nullptr: no prior term)
-  const float* trust;         ///< the prior's weight [0, 1] (nullptr iff prior is)
+  const float* texels;         ///< the view's texels, kTexelFloats per pixel, row-major
+  const float* prior;          ///< prior disparity [px] (nullptr: no prior term)
+  const float* trust;          ///< the prior's weight [0, 1] (nullptr iff prior is)
   int prior_step, trust_step;  ///< row steps [floats]
   int width, height;
-  int other_texel_stride;     ///< floats per row of the other view's texels
-  const int* offsets;         ///< window offsets in x and y [px]
+  int other_texel_stride;  ///< floats per row of the other view's texels
+  const int* offsets;      ///< window offsets in x and y [px]
   int offset_count;
-  const float* weight_lut;    ///< w by L1 colour distance times lut_scale
+  const float* weight_lut;  ///< w by L1 colour distance times lut_scale
   int lut_size;
   float lut_scale;
-  bool weighted;              ///< confidence-weighted phi (else the paper's)
+  bool weighted;  ///< confidence-weighted phi (else the paper's)
   float gamma, img_norm, lambda_disp;
 };
 

@@ -19,9 +19,6 @@ struct ViewState {
   float match_sign = -1.f;  ///< the match of x is at x + sign * d in the other view
   cv::Mat3f color;          ///< BGR float, 0..255
   cv::Mat2f grad;           ///< (gx, gy) of the grey image (central differences); empty if beta = 0
-  /// The colour and gradient as the AVX2 cost reads them: kTexelFloats per pixel, row-major
-  /// (B, G, R, 0, gx, gy, 0, 0). Empty on the baseline path.
-  std::vector<float> texels;
   cv::Mat1f prior;          ///< up-sampled LiDAR disparity [px], 0 = empty (may be empty())
   /// Weight [0, 1] of the prior per pixel: the prior's confidence with confidence_weighting, else
   /// 1 where the prior has a value (the paper). Empty when there is no prior.
@@ -34,6 +31,9 @@ struct ViewState {
   std::vector<uint8_t> locked;
   /// Planes of the coarse start, up-sampled (empty: none): the initial plane where admissible.
   std::vector<Plane> guide;
+  /// The colour and gradient as the AVX2 cost reads them: kTexelFloats per pixel, row-major
+  /// (B, G, R, 0, gx, gy, 0, 0). Empty on the baseline path.
+  std::vector<float> texels;
 
   bool bounded(int x, int y) const { return !lo.empty() && hi(y, x) > 0.f; }
   bool isLocked(int idx) const { return locked[idx] != 0; }
