@@ -12,7 +12,7 @@ namespace patchmatch {
 void WindowCache::reserve(size_t n) {
   for (auto* v : {&xs, &ys, &w_img, &w_lidar, &c0, &c1, &c2, &g0, &g1, &priors}) v->assign(n, 0.f);
   row_offset.assign(n, 0);
-  texels.assign(n * kTexelFloats, 0.f);
+  texels.assign(n, Texel{});
   texel_row.assign(n, 0);
 }
 
@@ -39,7 +39,7 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
   avx2_ = activeSimdPath() == SimdPath::kAvx2 && !self_.texels.empty() && !other_.texels.empty();
   const float x_max = static_cast<float>(self_.width - 1);
-  kernel_self_ = KernelSelf{self_.texels.data(),
+  kernel_self_ = KernelSelf{self_.texels.data()->v,
                             use_prior_ ? self_.prior.ptr<float>(0) : nullptr,
                             use_prior_ ? self_.trust.ptr<float>(0) : nullptr,
                             use_prior_ ? static_cast<int>(self_.prior.step1()) : 0,
@@ -56,7 +56,7 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
                             wg_,
                             img_norm_,
                             ldisp_};
-  kernel_ = KernelConstants{other_.texels.data(),
+  kernel_ = KernelConstants{other_.texels.data()->v,
                             x_max,
                             x_max - 1e-3f,
                             self_.match_sign,
@@ -78,7 +78,7 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
   if (cache.xs.size() < n) cache.reserve(n);
   if (avx2_) {
     const KernelWindowOut out{cache.xs.data(),       cache.ys.data(),     cache.w_img.data(),
-                              cache.w_lidar.data(),  cache.priors.data(), cache.texels.data(),
+                              cache.w_lidar.data(),  cache.priors.data(), cache.texels.data()->v,
                               cache.texel_row.data()};
     cache.count = buildWindowAvx2(kernel_self_, px, py, out, cache.padded, cache.constant);
     return;
@@ -133,7 +133,7 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
 float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, float bound) const {
   if (avx2_) {
     const KernelWindow w{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
-                         cache.w_lidar.data(),   cache.priors.data(), cache.texels.data(),
+                         cache.w_lidar.data(),   cache.priors.data(), cache.texels.data()->v,
                          cache.texel_row.data(), cache.padded,        cache.count,
                          cache.constant};
     return aggregateAvx2(w, kernel_, plane.a, plane.b, plane.c, bound);

@@ -34,8 +34,8 @@ inline float horizontalSum(__m256 v) {
 
 /// |own - interpolated| per texel channel of one sample; `t` the left node's texel, f in [0, 1).
 inline __m256 texelDifference(const float* t, const float* f, const float* own, __m256 abs_mask) {
-  const __m256 t0 = _mm256_loadu_ps(t);
-  const __m256 t1 = _mm256_loadu_ps(t + kTexelFloats);
+  const __m256 t0 = _mm256_load_ps(t);  // texels are 32-byte aligned (cost_kernel.h)
+  const __m256 t1 = _mm256_load_ps(t + kTexelFloats);
   const __m256 m = _mm256_add_ps(t0, _mm256_mul_ps(_mm256_broadcast_ss(f), _mm256_sub_ps(t1, t0)));
   return _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(own), m));
 }
@@ -63,6 +63,11 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
   while (j0 < j1 && px + s.offsets[j0] < 0) ++j0;
   while (j1 > j0 && px + s.offsets[j1 - 1] >= s.width) --j1;
   const int m = j1 - j0;
+  // Locals, not s's members: the stores below could alias them as far as the compiler knows.
+  const int* const cols = s.offsets + j0;
+  const float* const texels = s.texels;
+  const float* const prior = s.prior;
+  const float* const trust = s.trust;
   alignas(32) float xcol[kMaxOffsets + kSimdBlock];
   for (int j = 0; j < m + kSimdBlock; ++j) {
     xcol[j] = j < m ? static_cast<float>(px + s.offsets[j0 + j]) : 0.f;
@@ -78,20 +83,22 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
       _mm256_storeu_ps(out.ys + k + q, fy);
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.texel_row + k + q), row);
     }
-    const float* texel_row = s.texels + (static_cast<long>(y) * s.width + px) * kTexelFloats;
+    const float* texel_row = texels + (static_cast<long>(y) * s.width + px) * kTexelFloats;
+    float* own = out.texels + k * kTexelFloats;
     for (int j = 0; j < m; ++j) {
-      _mm256_storeu_ps(out.texels + (k + j) * kTexelFloats,
-                       _mm256_loadu_ps(texel_row + s.offsets[j0 + j] * kTexelFloats));
+      _mm256_store_ps(own + j * kTexelFloats, _mm256_load_ps(texel_row + cols[j] * kTexelFloats));
     }
-    if (s.prior != nullptr) {
-      const float* prior_row = s.prior + static_cast<long>(y) * s.prior_step + px;
-      const float* trust_row = s.trust + static_cast<long>(y) * s.trust_step + px;
+    float* priors = out.priors + k;
+    float* trusts = out.w_lidar + k;
+    if (prior != nullptr) {
+      const float* prior_row = prior + static_cast<long>(y) * s.prior_step + px;
+      const float* trust_row = trust + static_cast<long>(y) * s.trust_step + px;
       for (int j = 0; j < m; ++j) {
-        out.priors[k + j] = prior_row[s.offsets[j0 + j]];
-        out.w_lidar[k + j] = trust_row[s.offsets[j0 + j]];
+        priors[j] = prior_row[cols[j]];
+        trusts[j] = trust_row[cols[j]];
       }
     } else {
-      for (int j = 0; j < m; ++j) out.priors[k + j] = out.w_lidar[k + j] = 0.f;
+      for (int j = 0; j < m; ++j) priors[j] = trusts[j] = 0.f;
     }
     k += m;
   }
@@ -99,7 +106,7 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
     out.xs[j] = out.xs[0];
     out.ys[j] = out.ys[0];
     out.texel_row[j] = out.texel_row[0];
-    _mm256_storeu_ps(out.texels + j * kTexelFloats, _mm256_setzero_ps());
+    _mm256_store_ps(out.texels + j * kTexelFloats, _mm256_setzero_ps());
     out.priors[j] = 0.f;
     out.w_lidar[j] = 0.f;
   }

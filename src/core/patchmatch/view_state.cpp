@@ -69,12 +69,13 @@ void prepareTexels(ViewState& v) {
     v.texels.clear();
     return;
   }
-  v.texels.assign(static_cast<size_t>(v.width) * v.height * kTexelFloats, 0.f);
+  v.texels.assign(static_cast<size_t>(v.width) * v.height, Texel{});
   for (int y = 0; y < v.height; ++y) {
     const cv::Vec3f* crow = v.color.ptr<cv::Vec3f>(y);
     const cv::Vec2f* grow = v.grad.empty() ? nullptr : v.grad.ptr<cv::Vec2f>(y);
-    float* t = &v.texels[static_cast<size_t>(y) * v.width * kTexelFloats];
-    for (int x = 0; x < v.width; ++x, t += kTexelFloats) {
+    Texel* row = &v.texels[static_cast<size_t>(y) * v.width];
+    for (int x = 0; x < v.width; ++x) {
+      float* t = row[x].v;
       t[0] = crow[x][0];
       t[1] = crow[x][1];
       t[2] = crow[x][2];

@@ -37,7 +37,7 @@ struct WindowCache {
   std::vector<float> w_lidar;  ///< w(p, p') times the LiDAR term's factor of phi (0: no prior)
   std::vector<float> c0, c1, c2, g0, g1, priors;
   std::vector<int> row_offset;  ///< start of the sample's row in the other view's colour [floats]
-  std::vector<float> texels;    ///< the sample's texel (kTexelFloats each; AVX2 path only)
+  std::vector<Texel> texels;    ///< the sample's texel (AVX2 path only)
   std::vector<int> texel_row;   ///< start of the sample's row in the other view's texels [floats]
   float constant = 0.f;         ///< sum of the plane-independent terms (paper: empty prior)
   int count = 0;

@@ -12,6 +12,12 @@ namespace patchmatch {
 /// B, G, R, 0, gx, gy, 0, 0 (colour 0..255, gradient of the grey image; 0 without gradient).
 constexpr int kTexelFloats = 8;
 
+/// One texel, 32-byte aligned so that the kernel's 8-float loads never straddle a cache line
+/// (std::vector<Texel> allocates with that alignment in C++17).
+struct alignas(32) Texel {
+  float v[kTexelFloats];
+};
+
 /// Samples per SIMD block; WindowCache arrays are padded with zero-weight samples to a multiple.
 constexpr int kSimdBlock = 8;
 
