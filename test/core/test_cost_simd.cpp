@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "lidar_stereo_fusion/core/patchmatch.h"
@@ -178,12 +179,23 @@ void compareKernels(const CostCase& cc, uint32_t seed) {
   }
 }
 
+/// Fraction of pixels where two disparity maps differ by more than 1e-3 px.
+double differingFraction(const cv::Mat1f& a, const cv::Mat1f& b) {
+  int n = 0;
+  for (int y = 0; y < a.rows; ++y) {
+    for (int x = 0; x < a.cols; ++x) n += std::abs(a(y, x) - b(y, x)) > 1e-3f;
+  }
+  return static_cast<double>(n) / a.total();
+}
+
 }  // namespace
 
 TEST(CostSimd, ReportsTheActivePath) {
   const std::string level = lsf::simdLevel();
   EXPECT_TRUE(level == "avx2" || level == "baseline") << level;
-  if (!lsf::cpuHasAvx2Fma()) EXPECT_EQ(level, "baseline");
+  if (!lsf::cpuHasAvx2Fma()) {
+    EXPECT_EQ(level, "baseline");
+  }
 }
 
 TEST(CostSimd, KernelsAgreeConfidenceWeighted) {
@@ -206,15 +218,6 @@ TEST(CostSimd, KernelsAgreeWithoutGradient) {
   SKIP_WITHOUT_AVX2();
   compareKernels({true, true, false}, 5);
   compareKernels({false, true, false}, 6);
-}
-
-/// Fraction of pixels where two disparity maps differ by more than 1e-3 px.
-double differingFraction(const cv::Mat1f& a, const cv::Mat1f& b) {
-  int n = 0;
-  for (int y = 0; y < a.rows; ++y) {
-    for (int x = 0; x < a.cols; ++x) n += std::abs(a(y, x) - b(y, x)) > 1e-3f;
-  }
-  return static_cast<double>(n) / a.total();
 }
 
 TEST(CostSimd, PatchMatchSameOnBothPaths) {

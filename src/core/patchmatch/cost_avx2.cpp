@@ -1,5 +1,6 @@
-// PatchMatch: the matching cost C(p, xi) (cost.h) with AVX2 + FMA, 8 window samples at a time.
-// Compiled with -mavx2 -mfma (CMakeLists.txt) and run only where the CPU has both (simd.h).
+// PatchMatch: the matching cost C(p, xi) (cost.h) and its window with AVX2, 8 window samples at
+// a time. Compiled with -mavx2 -mfma -ffp-contract=off (CMakeLists.txt) and run only where the CPU
+// has both (simd.h); no FMA instruction is used, so that results stay the baseline's.
 // Includes nothing but intrinsics and the plain-data kernel interface (see cost_kernel.h).
 //
 // Per block of 8 samples: the disparity d, the match x_q and its interpolation weight f are
@@ -23,14 +24,6 @@ const bool kAvx2KernelBuilt = true;
 namespace {
 
 constexpr int kMaxOffsets = 101;  // window_radius <= 50 (PatchMatchParams::validate)
-
-/// Sum of the 8 lanes.
-inline float horizontalSum(__m256 v) {
-  __m128 s = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-  s = _mm_add_ps(s, _mm_movehl_ps(s, s));
-  s = _mm_add_ss(s, _mm_movehdup_ps(s));
-  return _mm_cvtss_f32(s);
-}
 
 /// |own - interpolated| per texel channel of one sample; `t` the left node's texel, f in [0, 1).
 inline __m256 texelDifference(const float* t, const float* f, const float* own, __m256 abs_mask) {
