@@ -15,6 +15,7 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
@@ -190,10 +191,12 @@ int run(const Options& o) {
   const std::vector<Case> cases = o.synthetic.empty() ? kittiCases(o)
                                                       : std::vector<Case>{syntheticCase(o)};
   const cv::Size size = cases.front().input.left.size();
-  std::printf("fusion_benchmark: %s (%dx%d, %zu points), method %s, %d threads, 1 warm-up + %d runs\n",
-              cases.size() == 1 ? cases.front().name.c_str() : "every frame", size.width,
-              size.height, cases.front().input.cloud.size(), lsf::methodName(params.method).c_str(),
-              threads, o.repeat);
+  std::printf(
+      "fusion_benchmark: %s (%dx%d, %zu points), method %s, %d threads, SIMD %s, 1 warm-up + %d "
+      "runs\n",
+      cases.size() == 1 ? cases.front().name.c_str() : "every frame", size.width, size.height,
+      cases.front().input.cloud.size(), lsf::methodName(params.method).c_str(), threads,
+      lsf::simdLevel(), o.repeat);
   cv::Ptr<cv::StereoSGBM> sgbm;
   if (o.sgbm) {
     sgbm = cv::StereoSGBM::create(0, 128, 5, 8 * 3 * 25, 32 * 3 * 25, 1, 63, 10, 100, 32,

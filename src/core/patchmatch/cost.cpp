@@ -4,12 +4,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
+
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
 void WindowCache::reserve(size_t n) {
   for (auto* v : {&xs, &ys, &w_img, &w_lidar, &c0, &c1, &c2, &g0, &g1, &priors}) v->assign(n, 0.f);
   row_offset.assign(n, 0);
+  texels.assign(n, Texel{});
+  texel_row.assign(n, 0);
 }
 
 MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self,
@@ -33,6 +37,36 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   use_prior_ = wg_ > 0.f && !self_.prior.empty();
   weighted_ = p_.confidence_weighting;
   img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
+  avx2_ = activeSimdPath() == SimdPath::kAvx2 && !self_.texels.empty() && !other_.texels.empty();
+  const float x_max = static_cast<float>(self_.width - 1);
+  kernel_self_ = KernelSelf{self_.texels.data()->v,
+                            use_prior_ ? self_.prior.ptr<float>(0) : nullptr,
+                            use_prior_ ? self_.trust.ptr<float>(0) : nullptr,
+                            use_prior_ ? static_cast<int>(self_.prior.step1()) : 0,
+                            use_prior_ ? static_cast<int>(self_.trust.step1()) : 0,
+                            self_.width,
+                            self_.height,
+                            kTexelFloats * other_.width,
+                            offsets_.data(),
+                            static_cast<int>(offsets_.size()),
+                            weight_lut_.data(),
+                            kLutSize,
+                            kLutScale,
+                            weighted_,
+                            wg_,
+                            img_norm_,
+                            ldisp_};
+  kernel_ = KernelConstants{other_.texels.data()->v,
+                            x_max,
+                            x_max - 1e-3f,
+                            self_.match_sign,
+                            static_cast<int>(offsets_.size()),
+                            wa_,
+                            use_grad_ ? wb_ : 0.f,
+                            lcol_,
+                            lgrad_,
+                            ldisp_,
+                            outside_cost_};
 }
 
 float MatchingCost::supportWeight(float l1) const {
@@ -40,8 +74,15 @@ float MatchingCost::supportWeight(float l1) const {
 }
 
 void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
-  const size_t n = offsets_.size() * offsets_.size();
+  const size_t n = offsets_.size() * offsets_.size() + kSimdBlock;  // room for the padding
   if (cache.xs.size() < n) cache.reserve(n);
+  if (avx2_) {
+    const KernelWindowOut out{cache.xs.data(),       cache.ys.data(),     cache.w_img.data(),
+                              cache.w_lidar.data(),  cache.priors.data(), cache.texels.data()->v,
+                              cache.texel_row.data()};
+    cache.count = buildWindowAvx2(kernel_self_, px, py, out, cache.padded, cache.constant);
+    return;
+  }
   cache.constant = 0.f;
   int k = 0;
   const cv::Vec3f center = self_.color(py, px);
@@ -86,16 +127,23 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
     }
   }
   cache.count = k;
+  cache.padded = k;
 }
 
 float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, float bound) const {
+  if (avx2_) {
+    const KernelWindow w{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
+                         cache.w_lidar.data(),   cache.priors.data(), cache.texels.data()->v,
+                         cache.texel_row.data(), cache.padded,        cache.count,
+                         cache.constant};
+    return aggregateAvx2(w, kernel_, plane.a, plane.b, plane.c, bound);
+  }
   return use_grad_ ? aggregateImpl<true>(cache, plane, bound)
                    : aggregateImpl<false>(cache, plane, bound);
 }
 
 template <bool kGrad>
-float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane,
-                                  float bound) const {
+float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const {
   float sum = cache.constant;
   if (sum >= bound) return sum;
   const float x_max = static_cast<float>(self_.width - 1);

@@ -9,6 +9,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
+
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
@@ -58,6 +61,30 @@ void prepareImages(const ViewInput& in, bool use_grad, ViewState& v) {
   cv::filter2D(grey, gx, CV_32F, kx, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
   cv::filter2D(grey, gy, CV_32F, kx.t(), cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
   cv::merge(std::vector<cv::Mat>{gx, gy}, v.grad);
+}
+
+/// The texels of the AVX2 cost (view_state.h): colour and gradient interleaved, padded to 8.
+void prepareTexels(ViewState& v) {
+  if (activeSimdPath() != SimdPath::kAvx2) {
+    v.texels.clear();
+    return;
+  }
+  v.texels.assign(static_cast<size_t>(v.width) * v.height, Texel{});
+  for (int y = 0; y < v.height; ++y) {
+    const cv::Vec3f* crow = v.color.ptr<cv::Vec3f>(y);
+    const cv::Vec2f* grow = v.grad.empty() ? nullptr : v.grad.ptr<cv::Vec2f>(y);
+    Texel* row = &v.texels[static_cast<size_t>(y) * v.width];
+    for (int x = 0; x < v.width; ++x) {
+      float* t = row[x].v;
+      t[0] = crow[x][0];
+      t[1] = crow[x][1];
+      t[2] = crow[x][2];
+      if (grow != nullptr) {
+        t[4] = grow[x][0];
+        t[5] = grow[x][1];
+      }
+    }
+  }
 }
 
 /// trust: the prior's confidence (confidence weighting) or 1 where the prior has a value.
@@ -124,6 +151,7 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
   v.height = in.image.rows;
   v.match_sign = match_sign;
   prepareImages(in, p.beta > 0, v);
+  prepareTexels(v);
   v.prior = in.prior;
   prepareTrust(in, p, v);
   v.lo = in.bounds.lo;

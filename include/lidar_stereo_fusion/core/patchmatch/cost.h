@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
 #include "lidar_stereo_fusion/core/patchmatch/plane.h"
 #include "lidar_stereo_fusion/core/patchmatch/view_state.h"
 
@@ -28,19 +29,25 @@ namespace patchmatch {
 
 /// The window samples of one pixel in structure-of-arrays form, built once per pixel and shared by
 /// every candidate plane. Arrays are sized once; `count` says how many entries are in use.
+/// The baseline kernel reads c0..g1 and row_offset; the AVX2 kernel reads texels and texel_row,
+/// and `padded` samples: the window padded to a multiple of kSimdBlock with zero-weight samples.
 struct WindowCache {
   std::vector<float> xs, ys;
   std::vector<float> w_img;    ///< w(p, p') times the image term's factor of phi
   std::vector<float> w_lidar;  ///< w(p, p') times the LiDAR term's factor of phi (0: no prior)
   std::vector<float> c0, c1, c2, g0, g1, priors;
   std::vector<int> row_offset;  ///< start of the sample's row in the other view's colour [floats]
+  std::vector<Texel> texels;    ///< the sample's texel (AVX2 path only)
+  std::vector<int> texel_row;   ///< start of the sample's row in the other view's texels [floats]
   float constant = 0.f;         ///< sum of the plane-independent terms (paper: empty prior)
   int count = 0;
+  int padded = 0;  ///< count rounded up to a multiple of kSimdBlock (AVX2 path)
   void reserve(size_t n);
 };
 
 class MatchingCost {
  public:
+  /// Uses the AVX2 kernel when activeSimdPath() is kAvx2 and both views have texels.
   MatchingCost(const PatchMatchParams& params, const ViewState& self, const ViewState& other);
 
   /// w(p, p') for an RGB L1 distance [0, 765].
@@ -52,6 +59,9 @@ class MatchingCost {
   /// C(p, plane) over the cached window. Stops early (returning a value >= bound) once the
   /// partial sum exceeds `bound`; exact otherwise.
   float aggregate(const WindowCache& cache, const Plane& plane, float bound) const;
+
+  /// Whether this cost runs the AVX2 kernel.
+  bool usesAvx2() const { return avx2_; }
 
   /// The window offsets used in x and y (multiples of window_stride within window_radius).
   const std::vector<int>& offsets() const { return offsets_; }
@@ -70,6 +80,9 @@ class MatchingCost {
   std::vector<float> weight_lut_;
   float wa_, wb_, wg_, lcol_, lgrad_, ldisp_, outside_cost_, img_norm_;
   bool use_grad_, use_prior_, weighted_;
+  bool avx2_;
+  KernelConstants kernel_;
+  KernelSelf kernel_self_;
 };
 
 }  // namespace patchmatch

@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
 #include "lidar_stereo_fusion/core/patchmatch/plane.h"
 
 namespace lidar_stereo_fusion {
@@ -36,6 +37,9 @@ struct ViewState {
   std::vector<uint8_t> locked;
   /// Planes of the coarse start, up-sampled (empty: none): the initial plane where admissible.
   std::vector<Plane> guide;
+  /// The colour and gradient as the AVX2 cost reads them: kTexelFloats per pixel, row-major
+  /// (B, G, R, 0, gx, gy, 0, 0). Empty on the baseline path.
+  std::vector<Texel> texels;
 
   bool bounded(int x, int y) const { return !lo.empty() && hi(y, x) > 0.f; }
   bool isLocked(int idx) const { return locked[idx] != 0; }

@@ -1,0 +1,251 @@
+// The AVX2 matching-cost kernel against the baseline one and a double-precision reference of the
+// equations in patchmatch/cost.h; whole PatchMatch runs on both paths.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/cost.h"
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
+#include "lidar_stereo_fusion/core/patchmatch/view_state.h"
+#include "test_scenes.h"
+
+namespace lsf = lidar_stereo_fusion;
+namespace pm = lidar_stereo_fusion::patchmatch;
+
+namespace {
+
+/// Restores the process's SIMD path when a test ends.
+class SimdPathGuard {
+ public:
+  SimdPathGuard() : saved_(lsf::activeSimdPath()) {}
+  ~SimdPathGuard() { lsf::setSimdPath(saved_); }
+
+ private:
+  lsf::SimdPath saved_;
+};
+
+#define SKIP_WITHOUT_AVX2()                                                               \
+  if (!lsf::cpuHasAvx2Fma()) {                                                            \
+    GTEST_SKIP() << "this CPU (or build) has no AVX2 + FMA: only the baseline path runs"; \
+  }
+
+/// Random BGR noise image.
+cv::Mat randomImage(int w, int h, std::mt19937& rng) {
+  cv::Mat img(h, w, CV_8UC3);
+  std::uniform_int_distribution<int> u(0, 255);
+  for (auto it = img.begin<cv::Vec3b>(); it != img.end<cv::Vec3b>(); ++it) {
+    *it = cv::Vec3b(u(rng), u(rng), u(rng));
+  }
+  return img;
+}
+
+/// A prior in [1, 60] px with ~30 % empty pixels, and a confidence with exact 0s and 1s.
+void randomPrior(int w, int h, std::mt19937& rng, cv::Mat1f& prior, cv::Mat1f& confidence) {
+  std::uniform_real_distribution<float> d(1.f, 60.f), u(0.f, 1.f);
+  prior.create(h, w);
+  confidence.create(h, w);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      prior(y, x) = u(rng) < 0.3f ? 0.f : d(rng);
+      const float c = u(rng);
+      confidence(y, x) = c < 0.2f ? 0.f : (c > 0.9f ? 1.f : c);
+    }
+  }
+}
+
+/// C(p, plane) of cost.h in double precision, straight from the equations. w is the
+/// implementation's: exp(-l / delta) with l the RGB L1 distance rounded down to 1/4 (its LUT).
+double referenceCost(const lsf::PatchMatchParams& p, const pm::ViewState& self,
+                     const pm::ViewState& other, int px, int py, const pm::Plane& plane) {
+  const bool use_prior = p.gamma > 0 && !self.prior.empty();
+  const double alpha = p.alpha, beta = p.beta, gamma = p.gamma;
+  const cv::Vec3f center = self.color(py, px);
+  double sum = 0;
+  for (int dy = -p.window_radius; dy <= p.window_radius; ++dy) {
+    for (int dx = -p.window_radius; dx <= p.window_radius; ++dx) {
+      const int x = px + dx, y = py + dy;
+      if (dy % p.window_stride || dx % p.window_stride) continue;
+      if (x < 0 || y < 0 || x >= self.width || y >= self.height) continue;
+      const cv::Vec3f c = self.color(y, x);
+      double l1 = 0;
+      for (int i = 0; i < 3; ++i) l1 += std::abs(double(c[i]) - center[i]);
+      const double w = std::exp(-std::min(std::floor(l1 * 4), 4095.0) / 4 / p.weight_delta);
+      const double d = double(plane.a) * x + double(plane.b) * y + plane.c;
+      const double xm = x + self.match_sign * d;
+      double rho_img = alpha * p.lambda_col + beta * p.lambda_grad;  // match outside the image
+      if (xm >= 0 && xm <= other.width - 1) {
+        const int x0 = std::min(static_cast<int>(xm), other.width - 2);
+        const double f = xm - x0;
+        double col = 0, grad = 0;
+        for (int i = 0; i < 3; ++i) {
+          const double m = (1 - f) * other.color(y, x0)[i] + f * other.color(y, x0 + 1)[i];
+          col += std::abs(c[i] - m);
+        }
+        for (int i = 0; i < 2 && beta > 0; ++i) {
+          const double m = (1 - f) * other.grad(y, x0)[i] + f * other.grad(y, x0 + 1)[i];
+          grad += std::abs(self.grad(y, x)[i] - m);
+        }
+        rho_img = alpha * std::min(col, p.lambda_col) + beta * std::min(grad, p.lambda_grad);
+      }
+      const double prior = use_prior ? self.prior(y, x) : 0.0;
+      const double trust = use_prior ? self.trust(y, x) : 0.0;
+      const double rho_lid = std::min(std::abs(prior - d), p.lambda_disp);
+      double phi;
+      if (p.confidence_weighting) {
+        const double kappa = gamma * trust;
+        phi = (1 - kappa) / (alpha + beta) * rho_img + kappa * rho_lid;
+      } else {
+        phi = rho_img + (use_prior ? gamma * (trust > 0 ? rho_lid : p.lambda_disp) : 0.0);
+      }
+      sum += w * phi;
+    }
+  }
+  return sum;
+}
+
+struct CostCase {
+  bool weighted, with_prior, with_grad;
+};
+
+/// Both kernels and the reference on random windows (borders included) and random planes, some
+/// matching outside the other image; then with random bounds (early exit).
+void compareKernels(const CostCase& cc, uint32_t seed) {
+  SimdPathGuard guard;
+  std::mt19937 rng(seed);
+  const int w = 97, h = 41;
+  lsf::PatchMatchParams p;
+  p.confidence_weighting = cc.weighted;
+  if (!cc.with_grad) {
+    p.alpha = 0.1;
+    p.beta = 0.0;
+  }
+  cv::Mat1f prior, confidence;
+  if (cc.with_prior) randomPrior(w, h, rng, prior, confidence);
+  const lsf::ViewInput left(randomImage(w, h, rng), prior, {}, confidence);
+  const lsf::ViewInput right(randomImage(w, h, rng), prior, {}, confidence);
+  lsf::setSimdPath(lsf::SimdPath::kAvx2);  // views with texels, for both kernels
+  pm::ViewState lv, rv;
+  pm::prepareView(left, p, -1.f, lv);
+  pm::prepareView(right, p, +1.f, rv);
+  for (const pm::ViewState* self : {&lv, &rv}) {
+    const pm::ViewState& other = self == &lv ? rv : lv;
+    lsf::setSimdPath(lsf::SimdPath::kAvx2);
+    const pm::MatchingCost fast(p, *self, other);
+    lsf::setSimdPath(lsf::SimdPath::kBaseline);
+    const pm::MatchingCost base(p, *self, other);
+    ASSERT_TRUE(fast.usesAvx2());
+    ASSERT_FALSE(base.usesAvx2());
+    pm::WindowCache fast_cache, base_cache;
+    std::uniform_int_distribution<int> ux(0, w - 1), uy(0, h - 1);
+    std::uniform_real_distribution<float> slope(-0.6f, 0.6f), disp(-30.f, 90.f), u01(0.f, 1.f);
+    for (int i = 0; i < 400; ++i) {
+      const int px = ux(rng), py = uy(rng);
+      const float a = slope(rng), b = slope(rng);
+      const pm::Plane plane{a, b, disp(rng) - a * px - b * py};
+      fast.buildWindow(px, py, fast_cache);
+      base.buildWindow(px, py, base_cache);
+      ASSERT_EQ(fast_cache.count, base_cache.count);
+      ASSERT_EQ(fast_cache.padded % pm::kSimdBlock, 0);
+      const float inf = std::numeric_limits<float>::max();
+      const float cf = fast.aggregate(fast_cache, plane, inf);
+      const float cb = base.aggregate(base_cache, plane, inf);
+      const double ref = referenceCost(p, *self, other, px, py, plane);
+      const auto where = ::testing::Message() << "seed " << seed << " pixel " << px << "," << py
+                                              << " plane " << a << " " << b << " " << plane.c;
+      // The AVX2 kernel repeats the baseline's float operations in its order: bit-identical.
+      ASSERT_EQ(cf, cb) << where;
+      ASSERT_NEAR(cb, ref, 1e-4 * std::max(1e-3, ref)) << where;
+      ASSERT_NEAR(cf, ref, 1e-4 * std::max(1e-3, ref)) << where;
+      // Early exit: a result below the bound is the full sum; else the full sum is not below it.
+      const float bound = cb * 2.f * u01(rng);
+      const float rf = fast.aggregate(fast_cache, plane, bound);
+      const float rb = base.aggregate(base_cache, plane, bound);
+      ASSERT_EQ(rf, rb) << where << " bound " << bound;  // same exit point too
+      for (const float r : {rf, rb}) {
+        if (r < bound) {
+          ASSERT_NEAR(r, cb, 1e-5 * std::max(1e-3f, cb)) << where << " bound " << bound;
+        } else {
+          ASSERT_GE(cb, bound * (1 - 1e-5f)) << where << " bound " << bound;
+        }
+      }
+    }
+  }
+}
+
+/// Fraction of pixels where two disparity maps differ by more than 1e-3 px.
+double differingFraction(const cv::Mat1f& a, const cv::Mat1f& b) {
+  int n = 0;
+  for (int y = 0; y < a.rows; ++y) {
+    for (int x = 0; x < a.cols; ++x) n += std::abs(a(y, x) - b(y, x)) > 1e-3f;
+  }
+  return static_cast<double>(n) / a.total();
+}
+
+}  // namespace
+
+TEST(CostSimd, ReportsTheActivePath) {
+  const std::string level = lsf::simdLevel();
+  EXPECT_TRUE(level == "avx2" || level == "baseline") << level;
+  if (!lsf::cpuHasAvx2Fma()) {
+    EXPECT_EQ(level, "baseline");
+  }
+}
+
+TEST(CostSimd, KernelsAgreeConfidenceWeighted) {
+  SKIP_WITHOUT_AVX2();
+  compareKernels({true, true, true}, 1);
+}
+
+TEST(CostSimd, KernelsAgreePaperCost) {
+  SKIP_WITHOUT_AVX2();
+  compareKernels({false, true, true}, 2);
+}
+
+TEST(CostSimd, KernelsAgreeWithoutPrior) {
+  SKIP_WITHOUT_AVX2();
+  compareKernels({true, false, true}, 3);
+  compareKernels({false, false, true}, 4);
+}
+
+TEST(CostSimd, KernelsAgreeWithoutGradient) {
+  SKIP_WITHOUT_AVX2();
+  compareKernels({true, true, false}, 5);
+  compareKernels({false, true, false}, 6);
+}
+
+TEST(CostSimd, PatchMatchSameOnBothPaths) {
+  SKIP_WITHOUT_AVX2();
+  SimdPathGuard guard;
+  // A slanted textured plane with a LiDAR-like prior: rows every 4th line, holes, mixed confidence.
+  const auto s = lsf::test::PlaneScene::make(240, 120, 0.06, 0.03, 12.0, 41);
+  cv::Mat1f prior(120, 240, 0.f), confidence(120, 240, 0.f);
+  for (int y = 0; y < 120; y += 4) {
+    for (int x = 30; x < 240; ++x) {
+      prior(y, x) = static_cast<float>(s.disparity(x, y));
+      confidence(y, x) = (x % 7) / 6.f;
+    }
+  }
+  for (const bool weighted : {true, false}) {
+    lsf::PatchMatchParams p;
+    p.confidence_weighting = weighted;
+    p.num_threads = 2;
+    const lsf::ViewInput left(s.left, prior, {}, confidence), right(s.right, cv::Mat1f(), {});
+    lsf::setSimdPath(lsf::SimdPath::kAvx2);
+    const auto fast = lsf::PatchMatchStereo(p).compute(left, right);
+    lsf::setSimdPath(lsf::SimdPath::kBaseline);
+    const auto base = lsf::PatchMatchStereo(p).compute(left, right);
+    const double differ = differingFraction(fast.disparity, base.disparity);
+    std::printf("[          ] confidence_weighting %d: %.4f %% of pixels differ by > 1e-3 px\n",
+                weighted, 100 * differ);
+    EXPECT_LE(differ, 1e-3) << "confidence_weighting " << weighted;
+    EXPECT_EQ(cv::norm(fast.disparity, base.disparity, cv::NORM_INF), 0.0)
+        << "the kernels are bit-identical, so should be the results";
+  }
+}
