@@ -109,8 +109,8 @@ std::vector<Case> kittiCases(const Options& o) {
   if (frames.empty()) throw std::runtime_error("no complete frame in " + o.drive);
   std::vector<Case> cases;
   for (const auto& f : frames) {
-    const bool wanted = o.frame == "all" || f.name == o.frame ||
-                        (o.frame.empty() && &f == &frames.front());
+    const bool wanted =
+        o.frame == "all" || f.name == o.frame || (o.frame.empty() && &f == &frames.front());
     if (!wanted) continue;
     const lsf::kitti::FrameData data = lsf::kitti::loadFrame(f, calib.camera);
     cases.push_back({f.name, {data.left, data.right, data.cloud, calib.T_cam_velo, calib.camera}});
@@ -147,7 +147,8 @@ Timing timeCase(const Case& c, lsf::FusionPipeline& pipeline, cv::StereoSGBM* sg
   for (int i = 0; i < repeat; ++i) {
     t.stats.push_back(pipeline.process(c.input).stats);
     if (!sgbm) continue;
-    t.sgbm_ms.push_back(timeMs([&] { sgbm->compute(c.input.left, c.input.right, sgbm_disparity); }));
+    t.sgbm_ms.push_back(
+        timeMs([&] { sgbm->compute(c.input.left, c.input.right, sgbm_disparity); }));
     t.ratios.push_back(t.stats.back().total_ms / t.sgbm_ms.back());
   }
   return t;
@@ -188,8 +189,8 @@ int run(const Options& o) {
   cv::setNumThreads(threads);
   params.validate();
 
-  const std::vector<Case> cases = o.synthetic.empty() ? kittiCases(o)
-                                                      : std::vector<Case>{syntheticCase(o)};
+  const std::vector<Case> cases =
+      o.synthetic.empty() ? kittiCases(o) : std::vector<Case>{syntheticCase(o)};
   const cv::Size size = cases.front().input.left.size();
   std::printf(
       "fusion_benchmark: %s (%dx%d, %zu points), method %s, %d threads, SIMD %s, 1 warm-up + %d "
@@ -207,7 +208,8 @@ int run(const Options& o) {
     printStages(timeCase(cases.front(), pipeline, sgbm.get(), o.repeat));
     return 0;
   }
-  std::printf("\n| frame | fused ms | PatchMatch ms | SGBM ms | fused / SGBM |\n|---|---|---|---|---|\n");
+  std::printf(
+      "\n| frame | fused ms | PatchMatch ms | SGBM ms | fused / SGBM |\n|---|---|---|---|---|\n");
   std::vector<double> ratios;
   for (const Case& c : cases) {
     const Timing t = timeCase(c, pipeline, sgbm.get(), o.repeat);

@@ -248,6 +248,7 @@ TEST(PatchMatchPostProcessing, ConfidentPriorFillsElseTheBackgroundNeighbour) {
 
 TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {
   lsf::PatchMatchParams p = params3x3();
+  p.full_size_unbounded = false;
   lsf::ScanLineBounds b;
   b.lo = cv::Mat1f::zeros(4, 6);
   b.hi = cv::Mat1f::zeros(4, 6);

@@ -62,11 +62,12 @@ struct PatchMatchParams {
   int coarse_scale = 2;
   int coarse_levels = 2;
   /// Whether the pixels without scan-line bounds (no LiDAR above and below) are searched at full
-  /// size too; false: they keep the plane of the level below (half size), which is where most of
-  /// the time of a frame with sky and facades above the LiDAR would go.
-  bool full_size_unbounded = false;
+  /// size too (the default); false: they keep the plane of the level below (half size), refined
+  /// but not propagated, in the left view only: ~1.4x faster on KITTI, 0.1-0.2 px less precise
+  /// where only the images decide (above the LiDAR's field of view).
+  bool full_size_unbounded = true;
   int fine_iterations = 1;
-  double fine_refine_range = 2.0;  ///< [px]
+  double fine_refine_range = 1.0;  ///< [px]
   int num_threads = 0;           ///< 0 = all cores (at most 256)
   uint64_t seed = 42;
   void validate() const;

@@ -21,6 +21,8 @@ namespace lidar_stereo_fusion {
 
 namespace {
 
+constexpr int kMedianRadius = 5;  // [px]
+
 void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument("PatchMatchParams: " + message);
 }
@@ -142,9 +144,10 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     result.inconsistent =
         leftRightCheck(result.disparity, result.right_disparity, static_cast<float>(p.lr_max_diff),
                        lockedToPrior(lv), p.confidence_weighting && !lv.prior.empty());
-    fillHoles(lv, result.inconsistent.clone(), std::max(p.window_radius, 5),
-              static_cast<float>(p.weight_delta), static_cast<float>(p.fill_confidence),
-              result.disparity, threadCount(p));
+    // The weighted median's window: 11x11 (sampled every 2nd pixel), Bleyer's filter size at this
+    // image scale; it does not grow with the matching window.
+    fillHoles(lv, result.inconsistent.clone(), kMedianRadius, static_cast<float>(p.weight_delta),
+              static_cast<float>(p.fill_confidence), result.disparity, threadCount(p));
   } else {
     result.inconsistent = cv::Mat1b(size, uchar(0));
   }

@@ -75,7 +75,7 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   const int idx = y * self_.width + x;
   if (self_.locked[idx] == kLockedToPrior) return;
   if (self_.locked[idx] == kSettledByGuide) {
-    if (self_.match_sign < 0) polishSettled(x, y, idx, cache);
+    if (self_.match_sign < 0) polishSettled(x, y, idx, iteration, cache);
     return;
   }
   cost_.buildWindow(x, y, cache);
@@ -94,15 +94,12 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   self_.cost[idx] = best_cost;
 }
 
-void PlaneSearch::polishSettled(int x, int y, int idx, WindowCache& cache) const {
+void PlaneSearch::polishSettled(int x, int y, int idx, int iteration, WindowCache& cache) const {
   cost_.buildWindow(x, y, cache);
   Plane best = self_.planes[idx];
   float best_cost = currentCost(idx, cache);
-  const float fx = static_cast<float>(x), fy = static_cast<float>(y);
-  for (const float step : {kPolishStep, -kPolishStep, 0.5f * kPolishStep, -0.5f * kPolishStep}) {
-    const Plane candidate{best.a, best.b, best.c + step};
-    if (admissible(x, y, candidate.at(fx, fy))) tryPlane(x, y, candidate, cache, best, best_cost);
-  }
+  Rng rng(streamKey(p_.seed, 0, iteration, idx));
+  refine(x, y, cache, rng, best, best_cost);  // from +-fine_refine_range: the pixel has a guide
   self_.planes[idx] = best;
   self_.cost[idx] = best_cost;
 }

@@ -3,8 +3,8 @@
 //
 //   C(p, xi) = sum_{p' in W_p} w(p, p') phi(p', q),   q = p' + s d_xi(p') in the other view
 //   w(p, p') = exp(-|I_p - I_p'|_1 / delta)
-//   rho_img  = alpha min(|I_p' - I_q|_1, lambda_col) + beta min(|grad I_p' - grad I_q|_1, lambda_grad)
-//   rho_lid  = min(|Pi(p') - d_xi(p')|, lambda_disp)
+//   rho_img  = alpha min(|I_p' - I_q|_1, lambda_col) + beta min(|grad I_p' - grad I_q|_1,
+//   lambda_grad) rho_lid  = min(|Pi(p') - d_xi(p')|, lambda_disp)
 //
 // Two readings of phi:
 //  * the paper (confidence_weighting = false): phi = rho_img + gamma rho_lid where the prior has a

@@ -44,10 +44,10 @@ class PlaneSearch {
   /// polishes a pixel settled by the coarse level (polishSettled).
   void processPixel(int x, int y, bool forward, int iteration, WindowCache& cache) const;
 
-  /// The sub-pixel step of a pixel settled by the coarse level (left view only): its plane shifted
-  /// by +-kPolishStep and +-kPolishStep / 2 px, the cheapest kept. A settled pixel's plane comes
-  /// from a level of half the size, whose refinement stops at 0.1 px there (0.2 px here).
-  void polishSettled(int x, int y, int idx, WindowCache& cache) const;
+  /// Plane refinement alone (no spatial propagation) of a pixel settled by the coarse level, in
+  /// the left view only: its plane comes from a level of half the size, whose refinement stops at
+  /// 0.1 px there (0.2 px here); refinement from +-fine_refine_range restores full-size precision.
+  void polishSettled(int x, int y, int idx, int iteration, WindowCache& cache) const;
 
   /// Replaces (best, best_cost) by `candidate` when it is admissible and cheaper.
   void tryPlane(int x, int y, const Plane& candidate, const WindowCache& cache, Plane& best,
@@ -67,7 +67,6 @@ class PlaneSearch {
 
   static constexpr float kMinNormalZ = 0.1f;     // rejects planes steeper than ~84 degrees
   static constexpr float kMinRefineStep = 0.1f;  // paper: stop when Delta_d_max < 0.1
-  static constexpr float kPolishStep = 0.2f;     // [px] see polishSettled
 
   const PatchMatchParams& p_;
   ViewState& self_;

@@ -27,7 +27,7 @@ struct ViewState {
   /// Weight [0, 1] of the prior per pixel: the prior's confidence with confidence_weighting, else
   /// 1 where the prior has a value (the paper). Empty when there is no prior.
   cv::Mat1f trust;
-  cv::Mat1f lo, hi, range;  ///< search bounds [px] (empty: unbounded)
+  cv::Mat1f lo, hi, range;         ///< search bounds [px] (empty: unbounded)
   float d_min = 0.f, d_max = 0.f;  ///< the image's disparity range [px]
   std::vector<Plane> planes;
   std::vector<float> cost;
