@@ -10,23 +10,9 @@
 namespace lidar_stereo_fusion {
 namespace {
 
-std::string format(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), fmt, v);
-  return buf;
-}
-
-std::string row(const std::vector<std::string>& cells) {
-  std::string line = "|";
-  for (const std::string& c : cells) line += " " + c + " |";
-  return line + "\n";
-}
-
-std::string separator(size_t columns) {
-  std::string line = "|";
-  for (size_t i = 0; i < columns; ++i) line += "---|";
-  return line + "\n";
-}
+using table::format;
+using table::row;
+using table::separator;
 
 constexpr Region kSplitRegions[] = {Region::kAbove, Region::kInside, Region::kEdge,
                                     Region::kElsewhere};

@@ -8,7 +8,8 @@
 #include <stdexcept>
 
 namespace lidar_stereo_fusion {
-namespace {
+
+namespace table {
 
 std::string format(const char* fmt, double v) {
   char buf[64];
@@ -27,6 +28,14 @@ std::string separator(size_t columns) {
   for (size_t i = 0; i < columns; ++i) line += "---|";
   return line + "\n";
 }
+
+}  // namespace table
+
+namespace {
+
+using table::format;
+using table::row;
+using table::separator;
 
 double nowSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();

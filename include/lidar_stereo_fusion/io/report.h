@@ -11,6 +11,16 @@
 
 namespace lidar_stereo_fusion {
 
+/// Markdown table pieces shared by the report writers.
+namespace table {
+/// `v` printed with the printf format `fmt` (one double conversion).
+std::string format(const char* fmt, double v);
+/// "| a | b | ... |" and a newline.
+std::string row(const std::vector<std::string>& cells);
+/// "|---|---|...|" for `columns` columns and a newline.
+std::string separator(size_t columns);
+}  // namespace table
+
 /// One row of a depth-metrics table (a frame, or a method's mean over frames).
 struct DepthRow {
   std::string name;
