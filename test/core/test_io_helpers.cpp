@@ -122,7 +122,9 @@ TEST(PseudoLidar, FirstRowSpreadsTheRowsOverTheLowerPartOnly) {
   for (int y = 0; y < 12; ++y) {
     const bool sampled = y == 5 || y == 7 || y == 9 || y == 11;
     EXPECT_EQ(cv::countNonZero(sparse.disparity.row(y)), sampled ? 3 : 0) << y;
-    if (sampled) EXPECT_EQ(sparse.ring(y, 0), (y - 5) / 2) << y;
+    if (sampled) {
+      EXPECT_EQ(sparse.ring(y, 0), (y - 5) / 2) << y;
+    }
   }
   EXPECT_EQ(scanLineRow(0, 4, 12, 4), 5);
   EXPECT_EQ(scanLineRow(3, 4, 12, 4), 11);
