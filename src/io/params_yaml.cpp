@@ -78,6 +78,7 @@ void visitPatchMatch(P& p, V& v) {
   v("view_propagation", p.view_propagation);
   v("lr_check", p.lr_check);
   v("lr_max_diff", p.lr_max_diff);
+  v("median_radius", p.median_radius);
   v("confidence_weighting", p.confidence_weighting);
   v("lock_confidence", p.lock_confidence);
   v("fill_confidence", p.fill_confidence);

@@ -63,6 +63,7 @@ void visitParams(FusionParams& p, Visitor&& v) {
   v("patchmatch", "view_propagation", m.view_propagation);
   v("patchmatch", "lr_check", m.lr_check);
   v("patchmatch", "lr_max_diff", m.lr_max_diff);
+  v("patchmatch", "median_radius", m.median_radius);
   v("patchmatch", "confidence_weighting", m.confidence_weighting);
   v("patchmatch", "lock_confidence", m.lock_confidence);
   v("patchmatch", "fill_confidence", m.fill_confidence);

@@ -67,6 +67,7 @@ FusionParams everyFieldChanged() {
   m.view_propagation = false;
   m.lr_check = false;
   m.lr_max_diff = 1.5;
+  m.median_radius = 7;
   m.confidence_weighting = false;
   m.lock_confidence = 0.75;
   m.fill_confidence = 0.25;
@@ -123,6 +124,7 @@ void expectSame(const FusionParams& a, const FusionParams& b) {
   EXPECT_EQ(x.view_propagation, y.view_propagation);
   EXPECT_EQ(x.lr_check, y.lr_check);
   EXPECT_EQ(x.lr_max_diff, y.lr_max_diff);
+  EXPECT_EQ(x.median_radius, y.median_radius);
   EXPECT_EQ(x.confidence_weighting, y.confidence_weighting);
   EXPECT_EQ(x.lock_confidence, y.lock_confidence);
   EXPECT_EQ(x.fill_confidence, y.fill_confidence);

@@ -21,8 +21,6 @@ namespace lidar_stereo_fusion {
 
 namespace {
 
-constexpr int kMedianRadius = 5;  // [px]
-
 void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument("PatchMatchParams: " + message);
 }
@@ -65,6 +63,7 @@ void PatchMatchParams::validate() const {
   require(min_disparity > 0, "min_disparity must be > 0");
   require(max_disparity > min_disparity, "max_disparity must be > min_disparity");
   require(lr_max_diff > 0, "lr_max_diff must be > 0");
+  require(median_radius >= 1 && median_radius <= 50, "median_radius must be in [1, 50]");
   require(std::isfinite(lock_confidence) && lock_confidence >= 0,
           "lock_confidence must be >= 0 (> 1 = never lock)");
   require(fill_confidence >= 0 && fill_confidence <= 1, "fill_confidence must be in [0, 1]");
@@ -144,9 +143,7 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     result.inconsistent =
         leftRightCheck(result.disparity, result.right_disparity, static_cast<float>(p.lr_max_diff),
                        lockedToPrior(lv), p.confidence_weighting && !lv.prior.empty());
-    // The weighted median's window: 11x11 (sampled every 2nd pixel), Bleyer's filter size at this
-    // image scale; it does not grow with the matching window.
-    fillHoles(lv, result.inconsistent.clone(), kMedianRadius, static_cast<float>(p.weight_delta),
+    fillHoles(lv, result.inconsistent.clone(), p.median_radius, static_cast<float>(p.weight_delta),
               static_cast<float>(p.fill_confidence), result.disparity, threadCount(p));
   } else {
     result.inconsistent = cv::Mat1b(size, uchar(0));
