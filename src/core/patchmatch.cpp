@@ -428,7 +428,7 @@ void PatchMatchParams::validate() const {
   require(min_disparity > 0, "min_disparity must be > 0");
   require(max_disparity > min_disparity, "max_disparity must be > min_disparity");
   require(lr_max_diff > 0, "lr_max_diff must be > 0");
-  require(num_threads >= 0, "num_threads must be >= 0 (0 = all cores)");
+  require(num_threads >= 0 && num_threads <= 256, "num_threads must be in [0, 256] (0 = all)");
 }
 
 /// Per-object buffers reused across frames (a fresh full-size buffer costs page faults every frame).

@@ -140,6 +140,8 @@ class FieldReader {
   void read(const cv::FileNode& node, const std::string& key, int& value) const {
     if (!node.isInt()) fail(key, "must be an integer");
     value = static_cast<int>(node);
+    // Checked here too (not only in validate()): a thread count beyond this crashes libgomp.
+    if (key == "num_threads" && (value < 0 || value > 256)) fail(key, "must be in [0, 256]");
   }
 
   void read(const cv::FileNode& node, const std::string& key, bool& value) const {

@@ -330,7 +330,7 @@ void FusionWorker::imageCb(const ImageConstPtr& left, const InfoConstPtr& left_i
   const ros::Time stamp = left->header.stamp;
   std::lock_guard<std::mutex> lock(data_mutex_);
   detectClockJump();
-  Matcher::Events events = matcher_.addImages(stamp, std::move(set), Clock::now());
+  Matcher::Events events = matcher_.addImages(stamp, std::move(set), ros::Time::now());
   handleEvents(events, kLeftImage, stamp);
 }
 
@@ -360,9 +360,10 @@ void FusionWorker::syncDropCb(const ImageConstPtr& left, const InfoConstPtr& lef
 void FusionWorker::cloudCb(const CloudConstPtr& cloud) {
   const ros::Time stamp = cloud->header.stamp;
   ROS_DEBUG_STREAM("[" << name_ << "] sweep " << stampText(stamp) << " ("
-                       << cloud->width * cloud->height << " points)");
+                       << static_cast<uint64_t>(cloud->width) * cloud->height << " points)");
   std::string problem = conversions::checkCloudLayout(*cloud);
-  if (problem.empty() && cloud->width * cloud->height == 0) problem = "empty cloud (0 points)";
+  if (problem.empty() && (cloud->width == 0 || cloud->height == 0))
+    problem = "empty cloud (0 points)";
   if (problem.empty() && cloud->header.frame_id.empty()) problem = "empty frame_id";
   if (!problem.empty()) {
     ++counters_.invalid;
@@ -372,7 +373,7 @@ void FusionWorker::cloudCb(const CloudConstPtr& cloud) {
   }
   std::lock_guard<std::mutex> lock(data_mutex_);
   detectClockJump();
-  Matcher::Events events = matcher_.addSweep(stamp, cloud, Clock::now());
+  Matcher::Events events = matcher_.addSweep(stamp, cloud, ros::Time::now());
   handleEvents(events, kCloud, stamp);
 }
 
@@ -468,8 +469,8 @@ void FusionWorker::workerLoop() {
       job_cv_.wait_for(lock, std::chrono::milliseconds(20),
                        [this] { return stop_ || static_cast<bool>(next_job_); });
       if (stop_) return;
-      // Image sets that waited max_sweep_wait for a later sweep are decided here.
-      Matcher::Events events = matcher_.poll(Clock::now());
+      // Image sets that waited max_sweep_wait (ROS time) for a later sweep are decided here.
+      Matcher::Events events = matcher_.poll(ros::Time::now());
       handleEvents(events, kLeftImage, ros::Time());
       if (!next_job_) continue;
       job = std::move(next_job_);
@@ -482,7 +483,15 @@ void FusionWorker::workerLoop() {
         params_changed_ = false;
       }
     }
-    processMatch(*job, pipeline);
+    try {
+      processMatch(*job, pipeline);
+    } catch (const std::exception& e) {  // last line of defence: the worker thread must not die
+      ++counters_.errors;
+      warnThrottled("process",
+                    std::string("frame at ") + stampText(job->image_stamp) +
+                        " failed: " + e.what() + "; frame skipped",
+                    true);
+    }
   }
 }
 
@@ -515,7 +524,7 @@ void FusionWorker::processMatch(const Match& match, FusionPipeline& pipeline) {
     conversions::stereoPairToCore(set.left, set.right, input.left, input.right);
     input.camera = conversions::stereoCameraFromInfo(*set.left_info, *set.right_info);
     cloud = conversions::cloudFromMsg(cloud_msg);
-  } catch (const conversions::ConversionError& e) {
+  } catch (const std::exception& e) {  // ConversionError, and anything OpenCV lets through
     ++counters_.invalid;
     warnThrottled("convert", std::string("cannot convert the input set at ") +
                                  stampText(match.image_stamp) + ": " + e.what() +

@@ -63,6 +63,7 @@ struct SetSpec {
   int right_width = 0;  ///< 0 = same as the left image
   enum class Cloud { kNormal, kNone, kEmpty, kNaN, kNoRing, kCustom } cloud = Cloud::kNormal;
   sensor_msgs::PointCloud2Ptr custom_cloud;
+  sensor_msgs::ImagePtr custom_left;  ///< published instead of the left image (stamp set here)
   std::string cloud_frame = kLidarFrame;
   double cloud_offset = 0.0;        ///< sweep stamp - image stamp [s]
   bool cloud_first = false;         ///< publish the sweep before the images
@@ -149,7 +150,11 @@ class Harness {
   void publishSet(const SetSpec& spec, const ros::Time& stamp) {
     const auto& frame = frames_[spec.frame % frames_.size()];
     const ros::Time right_stamp = stamp + ros::Duration(spec.right_stamp_offset);
-    auto left = lsf::test::imageMsg(frame.left, spec.left_encoding, kCameraFrame, stamp);
+    sensor_msgs::ImagePtr left =
+        spec.custom_left ? boost::make_shared<sensor_msgs::Image>(*spec.custom_left)
+                         : lsf::test::imageMsg(frame.left, spec.left_encoding, kCameraFrame, stamp);
+    left->header.stamp = stamp;
+    left->header.frame_id = kCameraFrame;
     cv::Mat right_bgr = frame.right;
     lsf::StereoCamera right_camera = frame.camera;
     if (spec.right_width > 0) {
@@ -422,6 +427,22 @@ TEST_F(FusionNode, A_LazySubscription) {
     h().unsubscribeOutputs();
     EXPECT_TRUE(h().inputsSubscribed(false, 10.0)) << "inputs still subscribed after " << output;
   }
+}
+
+// Crash 3 of issue 9: the .test files set ~patchmatch/num_threads to 100000 through rosparam
+// (~expect_num_threads_rejected); libgomp crashed at the first frame. The node keeps the default,
+// says so, and writes the value in use back to the parameter server.
+TEST_F(FusionNode, A2_ThreadCountBeyondTheCapIsNotApplied) {
+  ros::NodeHandle pnh("~");
+  if (!pnh.param("expect_num_threads_rejected", false)) GTEST_SKIP() << "not set in this .test";
+  int threads = -1;
+  ASSERT_TRUE(Harness::waitFor(30.0, [&] {
+    return ros::param::get(h().fusionNode() + "/patchmatch/num_threads", threads) &&
+           threads != 100000;
+  })) << "the node did not replace num_threads 100000 by the value in use";
+  EXPECT_GE(threads, 0);
+  EXPECT_LE(threads, 256);
+  EXPECT_TRUE(h().processAlive());
 }
 
 TEST_F(FusionNode, B_OneOutputPerInputSetOnEveryTopic) {
@@ -766,6 +787,42 @@ TEST_F(FusionNode, L_DiagnosticsReportRateAndProcessingTime) {
       has_time = has_time || v.key == "processing time mean [ms]";
     EXPECT_TRUE(has_time);
   }
+}
+
+// Crashes 1 and 2 of issue 9, through the node: a PointCloud2 field at offset 2^32 - 4 (read 4 GiB
+// past the buffer) and a bgra8 image 2^30 wide with step 1 (width * channels wrapped, uncaught
+// cv::Exception). Both are rejected with a warning naming the topic; the process lives on.
+TEST_F(FusionNode, M_MessagesThatOnceCrashedTheManagerAreRejected) {
+  const auto& frame = h().frames().front();
+  auto cloud = lsf::test::cloudMsg(frame.cloud, kLidarFrame, ros::Time());
+  for (auto& f : cloud->fields) {
+    if (f.name == "intensity") f.offset = 4294967292u;
+  }
+  SetSpec bad_cloud;
+  bad_cloud.cloud = SetSpec::Cloud::kCustom;
+  bad_cloud.custom_cloud = cloud;
+  std::size_t mark = h().logMark();
+  ros::Time stamp = h().nextStamp();
+  h().publishSet(bad_cloud, stamp);
+  EXPECT_EQ(h().outputsAfter(stamp), 0);
+  EXPECT_TRUE(h().waitForLog(mark, {"velodyne_points", "4294967292"})) << h().logsSince(mark);
+  expectStillProducing("a cloud field at offset 2^32 - 4");
+
+  auto wide = boost::make_shared<sensor_msgs::Image>();
+  wide->encoding = "bgra8";
+  wide->width = 1u << 30;
+  wide->height = 1;
+  wide->step = 1;
+  wide->data.assign(64, 0);
+  SetSpec bad_image;
+  bad_image.custom_left = wide;
+  mark = h().logMark();
+  stamp = h().nextStamp();
+  h().publishSet(bad_image, stamp);
+  EXPECT_EQ(h().outputsAfter(stamp), 0);
+  EXPECT_TRUE(h().waitForLog(mark, {"left/image_rect_color", "1073741824"}))
+      << h().logsSince(mark);
+  expectStillProducing("a bgra8 image 2^30 pixels wide");
 }
 
 // Only in fusion_approx_sync.test: right image and info stamped 4 ms after the left ones.

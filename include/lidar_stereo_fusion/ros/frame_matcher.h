@@ -3,12 +3,16 @@
 // velodyne_pointcloud stamps a sweep at its last packet, so the sweep that covers an image is
 // usually stamped after it and arrives after it. An image set therefore waits (pending) until a
 // sweep stamped at or after the image has arrived -- from then on no later sweep can be nearer --
-// or until it has waited `max_wait` (wall time), and then takes the sweep nearest in time, looking
-// both ways, if that is within `max_time_offset`; otherwise it is given up ("unmatched").
+// or until ROS time has moved `max_wait` past its arrival, and then takes the sweep nearest in
+// time, looking both ways, if that is within `max_time_offset`; otherwise it is given up
+// ("unmatched").
+//
+// Every "now" is ROS time (ros::Time::now(): simulated time under `rosbag play --clock` with
+// /use_sim_time), never wall time: a bag played at -r 0.05 or paused pairs exactly as at real
+// time, because the wait scales with the playback.
 #pragma once
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <deque>
@@ -22,11 +26,9 @@ namespace lidar_stereo_fusion {
 template <class Images, class Sweep>
 class FrameMatcher {
  public:
-  using Clock = std::chrono::steady_clock;
-
   struct Params {
     double max_time_offset = 0.1;        ///< [s] largest |sweep stamp - image stamp| accepted
-    double max_wait = 0.3;               ///< [s] wall time an image set waits for a later sweep
+    double max_wait = 0.3;               ///< [s] ROS time an image set waits for a later sweep
     std::size_t sweep_buffer_size = 10;  ///< recent sweeps kept
     std::size_t max_pending = 4;  ///< image sets waiting at most; the oldest is decided first
     /// [s] a stamp this much older than the last one is a restart of time (a bag played with
@@ -54,8 +56,8 @@ class FrameMatcher {
   void setParams(const Params& params) { params_ = params; }
   const Params& params() const { return params_; }
 
-  /// Adds a synchronised image set stamped `stamp`.
-  Events addImages(const ros::Time& stamp, Images images, Clock::time_point now) {
+  /// Adds a synchronised image set stamped `stamp`, arriving at ROS time `now`.
+  Events addImages(const ros::Time& stamp, Images images, const ros::Time& now) {
     Events events;
     if (have_image_ && stamp <= last_image_stamp_) {
       if ((last_image_stamp_ - stamp).toSec() <= params_.restart_step) {
@@ -72,8 +74,8 @@ class FrameMatcher {
     return events;
   }
 
-  /// Adds a sweep stamped `stamp`.
-  Events addSweep(const ros::Time& stamp, Sweep sweep, Clock::time_point now) {
+  /// Adds a sweep stamped `stamp`, arriving at ROS time `now`.
+  Events addSweep(const ros::Time& stamp, Sweep sweep, const ros::Time& now) {
     Events events;
     if (!sweeps_.empty() && stamp <= sweeps_.back().first) {
       if ((sweeps_.back().first - stamp).toSec() <= params_.restart_step) {
@@ -90,8 +92,8 @@ class FrameMatcher {
     return events;
   }
 
-  /// Decides sets that have waited long enough; call periodically.
-  Events poll(Clock::time_point now) {
+  /// Decides sets that have waited long enough (ROS time `now`); call periodically.
+  Events poll(const ros::Time& now) {
     Events events;
     resolve(events, now);
     return events;
@@ -113,15 +115,15 @@ class FrameMatcher {
   struct Pending {
     ros::Time stamp;
     Images images;
-    Clock::time_point arrival;
+    ros::Time arrival;  ///< ROS time of arrival
   };
 
-  void resolve(Events& events, Clock::time_point now) {
-    const auto max_wait = std::chrono::duration<double>(params_.max_wait);
+  void resolve(Events& events, const ros::Time& now) {
     while (!pending_.empty()) {
       Pending& p = pending_.front();
       const bool later_sweep_seen = !sweeps_.empty() && sweeps_.back().first >= p.stamp;
-      const bool waited_enough = now - p.arrival >= max_wait;
+      // ROS time that went back (a bag loop) is not waiting: the caller clears the buffers then.
+      const bool waited_enough = now >= p.arrival && (now - p.arrival).toSec() >= params_.max_wait;
       const bool too_many = pending_.size() > std::max<std::size_t>(params_.max_pending, 1);
       if (!later_sweep_seen && !waited_enough && !too_many) break;  // later ones wait too
       const auto best = nearestSweep(p.stamp);

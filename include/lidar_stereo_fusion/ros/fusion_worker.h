@@ -61,7 +61,7 @@ struct NodeParams {
   bool approximate_sync = false;  ///< ApproximateTime instead of ExactTime for the image set
   int queue_size = 5;             ///< synchroniser queue per topic
   double max_time_offset = 0.1;   ///< [s] largest |sweep stamp - image stamp|
-  double max_sweep_wait = 0.3;    ///< [s] wall time an image set waits for a later sweep
+  double max_sweep_wait = 0.3;    ///< [s] ROS time (sim time aware) a set waits for a later sweep
   int sweep_buffer_size = 10;     ///< recent sweeps kept for matching
   double tf_timeout = 0.05;       ///< [s] LiDAR -> camera TF lookup timeout (worker thread)
   int num_rings = 64;             ///< rings recovered by elevation for clouds without `ring`
