@@ -41,6 +41,7 @@ lsf_add_ros_test_node(test_fusion_node test/ros/test_fusion_node.cpp)
 add_rostest(test/ros/fusion_nodelet.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_node.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_approx_sync.test DEPENDENCIES test_fusion_node)
+add_rostest(test/ros/fusion_max_rate.test DEPENDENCIES test_fusion_node)
 
 # RViz with rviz/fusion.rviz under Xvfb: the fused cloud is drawn (screenshots in the build folder).
 lsf_add_ros_test_node(test_rviz_screenshot test/ros/test_rviz_screenshot.cpp)

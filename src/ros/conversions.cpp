@@ -112,6 +112,14 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
                                   const sensor_msgs::CameraInfo& right) {
   const auto& Pl = left.P;
   const auto& Pr = right.P;
+  for (std::size_t i : {0u, 2u, 3u, 5u, 6u}) {  // the entries used below, of both cameras
+    if (!std::isfinite(Pl[i]) || !std::isfinite(Pr[i])) {
+      throw ConversionError(std::string(std::isfinite(Pl[i]) ? "right" : "left") +
+                            " camera_info: P[" + std::to_string(i) + "] is " +
+                            std::to_string(std::isfinite(Pl[i]) ? Pr[i] : Pl[i]) +
+                            " (not finite); is the camera calibrated?");
+    }
+  }
   if (Pl[0] <= 0.0 || Pl[5] <= 0.0) {
     throw ConversionError("left camera_info: P has no focal length (fx = " + std::to_string(Pl[0]) +
                           ", fy = " + std::to_string(Pl[5]) + "); is the camera calibrated?");
@@ -144,6 +152,11 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
     throw ConversionError(
         "right camera_info: P[3] (Tx = -fx * baseline) is " + std::to_string(Pr[3]) +
         ", equal to the left one: no baseline (is this the right camera's info?)");
+  }
+  const std::string implausible = baselinePlausibilityProblem(camera.baseline);
+  if (!implausible.empty()) {
+    throw ConversionError("right camera_info: P[3] = " + std::to_string(Pr[3]) + " gives a " +
+                          implausible);
   }
   return camera;
 }

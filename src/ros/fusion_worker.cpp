@@ -28,6 +28,7 @@ namespace {
 
 constexpr double kThrottlePeriod = 5.0;  ///< [s] per topic and problem
 constexpr std::size_t kDiagWindow = 30;  ///< frames averaged in the processing diagnostics
+constexpr std::size_t kMaxLogKeys = 64;  ///< (topic, kind) pairs remembered by the throttle
 
 const char* const kLeftImage = "left/image_rect_color";
 const char* const kLeftInfo = "left/camera_info";
@@ -81,6 +82,7 @@ NodeParams NodeParams::read(const ros::NodeHandle& pnh) {
   readChecked(pnh, "num_rings", p.num_rings, positive, "must be > 0");
   readChecked(pnh, "cloud_stride", p.cloud_stride, positive, "must be > 0");
   readChecked(pnh, "max_output_depth", p.max_output_depth, non_negative, "must be >= 0 [m]");
+  readChecked(pnh, "max_rate", p.max_rate, non_negative, "must be >= 0 [Hz] (0 = no limit)");
   readChecked(
       pnh, "worker_nice", p.worker_nice, [](int v) { return v >= 0 && v <= 19; },
       "must be in [0, 19]");
@@ -199,6 +201,7 @@ void FusionWorker::advertise() {
   pub_depth_info_ = nh_.advertise<sensor_msgs::CameraInfo>("depth/camera_info", 1, ros_cb, ros_cb);
   pub_lidar_disparity_ = it_->advertise("lidar_disparity", 1, it_cb, it_cb);
   pub_disparity_image_ = it_->advertise("disparity_image", 1, it_cb, it_cb);
+  pub_confidence_ = it_->advertise("confidence", 1, it_cb, it_cb);
 }
 
 void FusionWorker::connectCb() {
@@ -207,7 +210,7 @@ void FusionWorker::connectCb() {
       pub_disparity_.getNumSubscribers() + pub_points_.getNumSubscribers() +
       pub_stats_.getNumSubscribers() + pub_depth_.getNumSubscribers() +
       pub_depth_info_.getNumSubscribers() + pub_lidar_disparity_.getNumSubscribers() +
-      pub_disparity_image_.getNumSubscribers();
+      pub_disparity_image_.getNumSubscribers() + pub_confidence_.getNumSubscribers();
   if (subscribers == 0 && subscribed_) {
     unsubscribe();
   } else if (subscribers > 0 && !subscribed_) {
@@ -246,18 +249,28 @@ std::string FusionWorker::topicName(const std::string& relative) const {
   return nh_.resolveName(relative);
 }
 
-void FusionWorker::warnThrottled(const std::string& key, const std::string& text, bool error) {
+void FusionWorker::logThrottled(Level level, const std::string& topic, const std::string& kind,
+                                const std::string& text) {
   const ros::WallTime now = ros::WallTime::now();
+  const std::string key = topic + '|' + kind;
   {
     std::lock_guard<std::mutex> lock(log_mutex_);
     auto it = last_log_.find(key);
     if (it != last_log_.end() && (now - it->second).toSec() < kThrottlePeriod) return;
+    // Topics and kinds are fixed words, so this never triggers in practice; it bounds the map
+    // whatever a caller passes.
+    if (it == last_log_.end() && last_log_.size() >= kMaxLogKeys) last_log_.clear();
     last_log_[key] = now;
   }
-  if (error) {
-    ROS_ERROR_STREAM("[" << name_ << "] " << text);
-  } else {
-    ROS_WARN_STREAM("[" << name_ << "] " << text);
+  switch (level) {
+    case Level::kInfo:
+      ROS_INFO_STREAM("[" << name_ << "] " << text);
+      break;
+    case Level::kWarn:
+      ROS_WARN_STREAM("[" << name_ << "] " << text);
+      break;
+    default:
+      ROS_ERROR_STREAM("[" << name_ << "] " << text);
   }
 }
 
@@ -271,8 +284,9 @@ void FusionWorker::detectClockJump() {
   if (!last_clock_.isZero() && now + ros::Duration(0.5) < last_clock_) {
     const std::size_t dropped = matcher_.clear();
     counters_.dropped += static_cast<uint32_t>(dropped);
-    ROS_INFO_STREAM("[" << name_ << "] ROS time jumped back from " << stampText(last_clock_)
-                        << " to " << stampText(now) << ": sweep and image buffers cleared");
+    logThrottled(Level::kInfo, "clock", "jump",
+                 "ROS time jumped back from " + stampText(last_clock_) + " to " + stampText(now) +
+                     ": sweep and image buffers cleared (bag loop?)");
   }
   last_clock_ = now;
 }
@@ -281,8 +295,9 @@ bool FusionWorker::checkImageSet(const ImageSet& set) {
   const auto reject = [this](const std::string& topic, const std::string& problem,
                              const ros::Time& stamp) {
     ++counters_.invalid;
-    warnThrottled(topic + problem, topicName(topic) + ": " + problem + " (stamp " +
-                                       stampText(stamp) + "); image set skipped");
+    warnThrottled(
+        topic, "invalid",
+        topicName(topic) + ": " + problem + " (stamp " + stampText(stamp) + "); image set skipped");
     return false;
   };
   const ros::Time stamp = set.left->header.stamp;
@@ -325,9 +340,21 @@ bool FusionWorker::checkImageSet(const ImageSet& set) {
 void FusionWorker::imageCb(const ImageConstPtr& left, const InfoConstPtr& left_info,
                            const ImageConstPtr& right, const InfoConstPtr& right_info) {
   ROS_DEBUG_STREAM("[" << name_ << "] image set " << stampText(left->header.stamp));
-  ImageSet set{left, right, left_info, right_info};
-  if (!checkImageSet(set)) return;
   const ros::Time stamp = left->header.stamp;
+  if (node_params_.max_rate > 0.0) {
+    // ~max_rate: sets closer than the period (less 10 % for stamp jitter) to the last accepted one
+    // are dropped here, before any work; counted, never warned about (the user asked for it).
+    std::lock_guard<std::mutex> lock(data_mutex_);
+    const double min_step = 0.9 / node_params_.max_rate;
+    if (!last_accepted_stamp_.isZero() && stamp >= last_accepted_stamp_ &&
+        (stamp - last_accepted_stamp_).toSec() < min_step) {
+      ++counters_.rate_limited;
+      return;
+    }
+    last_accepted_stamp_ = stamp;
+  }
+  ImageSet set{left, right, left_info, right_info, ros::Time::now(), Clock::now()};
+  if (!checkImageSet(set)) return;
   std::lock_guard<std::mutex> lock(data_mutex_);
   detectClockJump();
   Matcher::Events events = matcher_.addImages(stamp, std::move(set), ros::Time::now());
@@ -352,9 +379,10 @@ void FusionWorker::syncDropCb(const ImageConstPtr& left, const InfoConstPtr& lef
     stamp = left_info->header.stamp;
   else if (right_info)
     stamp = right_info->header.stamp;
-  warnThrottled("sync_drop", "incomplete image set at stamp " + stampText(stamp) +
-                                 " dropped by the exact-time synchroniser; missing:" + missing +
-                                 " (different stamps? then set ~approximate_sync true)");
+  warnThrottled("image set", "incomplete",
+                "incomplete image set at stamp " + stampText(stamp) +
+                    " dropped by the exact-time synchroniser; missing:" + missing +
+                    " (different stamps? then set ~approximate_sync true)");
 }
 
 void FusionWorker::cloudCb(const CloudConstPtr& cloud) {
@@ -367,8 +395,9 @@ void FusionWorker::cloudCb(const CloudConstPtr& cloud) {
   if (problem.empty() && cloud->header.frame_id.empty()) problem = "empty frame_id";
   if (!problem.empty()) {
     ++counters_.invalid;
-    warnThrottled(std::string(kCloud) + problem, topicName(kCloud) + ": " + problem + " (stamp " +
-                                                     stampText(stamp) + "); sweep skipped");
+    warnThrottled(
+        kCloud, "invalid",
+        topicName(kCloud) + ": " + problem + " (stamp " + stampText(stamp) + "); sweep skipped");
     return;
   }
   std::lock_guard<std::mutex> lock(data_mutex_);
@@ -382,24 +411,37 @@ void FusionWorker::handleEvents(Matcher::Events& events, const std::string& topi
   // Called with data_mutex_ held.
   if (events.restarted) {
     counters_.dropped += static_cast<uint32_t>(events.discarded);
-    ROS_INFO_STREAM(
-        "[" << name_ << "] " << topicName(topic) << ": stamp " << stampText(stamp)
-            << " is more than " << matcher_.params().restart_step
-            << " s older than the last one: time restarted (bag loop?), buffers cleared");
+    std::ostringstream text;
+    text << topicName(topic) << ": stamp " << stampText(stamp) << " is more than "
+         << matcher_.params().restart_step
+         << " s older than the last one: time restarted (bag loop?), buffers cleared";
+    logThrottled(Level::kInfo, topic, "restart", text.str());
   }
   if (events.out_of_order) {
     ++counters_.out_of_order;
-    warnThrottled(topic + "order", topicName(topic) + ": stamp " + stampText(stamp) +
-                                       " is not newer than one already received (out of order or "
-                                       "duplicate); message dropped");
+    warnThrottled(topic, "order",
+                  topicName(topic) + ": stamp " + stampText(stamp) +
+                      " is not newer than one already received (out of order or "
+                      "duplicate); message dropped");
   }
-  for (const ros::Time& t : events.unmatched) {
+  for (std::size_t i = 0; i < events.unmatched.size(); ++i) {
     ++counters_.unmatched;
-    warnThrottled("unmatched", "no sweep on " + topicName(kCloud) + " within " +
-                                   std::to_string(node_params_.max_time_offset) +
-                                   " s of the image set at " + stampText(t) +
-                                   "; image set skipped (is the LiDAR publishing? raise "
-                                   "~max_time_offset if the clocks differ)");
+    const std::string at = " of the image set at " + stampText(events.unmatched[i]);
+    if (events.unmatched_waited[i]) {  // no sweep at or after the set came in time
+      warnThrottled(kCloud, "late",
+                    "no sweep on " + topicName(kCloud) + " stamped at or after the image set at " +
+                        stampText(events.unmatched[i]) + " arrived within ~max_sweep_wait = " +
+                        std::to_string(node_params_.max_sweep_wait) +
+                        " s (ROS time), and none before it within ~max_time_offset = " +
+                        std::to_string(node_params_.max_time_offset) +
+                        " s; image set skipped (is the LiDAR publishing? raise ~max_sweep_wait "
+                        "if its sweeps arrive late)");
+    } else {
+      warnThrottled(kCloud, "unmatched",
+                    "no sweep on " + topicName(kCloud) + " within ~max_time_offset = " +
+                        std::to_string(node_params_.max_time_offset) + " s" + at +
+                        "; image set skipped (raise ~max_time_offset if the clocks differ)");
+    }
   }
   if (events.ready.empty()) return;
   ROS_DEBUG_STREAM("[" << name_ << "] matched image set "
@@ -487,10 +529,9 @@ void FusionWorker::workerLoop() {
       processMatch(*job, pipeline);
     } catch (const std::exception& e) {  // last line of defence: the worker thread must not die
       ++counters_.errors;
-      warnThrottled("process",
-                    std::string("frame at ") + stampText(job->image_stamp) +
-                        " failed: " + e.what() + "; frame skipped",
-                    true);
+      logThrottled(Level::kError, "pipeline", "error",
+                   std::string("frame at ") + stampText(job->image_stamp) + " failed: " + e.what() +
+                       "; frame skipped");
     }
   }
 }
@@ -509,7 +550,7 @@ void FusionWorker::processMatch(const Match& match, FusionPipeline& pipeline) {
     input.T_cam_lidar = tf2::transformToEigen(tf);
   } catch (const tf2::TransformException& e) {
     ++counters_.tf_failures;
-    warnThrottled("tf" + lidar_frame + camera_frame,
+    warnThrottled(kCloud, "tf",
                   "no transform from '" + lidar_frame + "' (" + topicName(kCloud) + ") to '" +
                       camera_frame + "' (" + topicName(kLeftImage) + ") at sweep stamp " +
                       stampText(match.sweep_stamp) + " within " +
@@ -526,28 +567,28 @@ void FusionWorker::processMatch(const Match& match, FusionPipeline& pipeline) {
     cloud = conversions::cloudFromMsg(cloud_msg);
   } catch (const std::exception& e) {  // ConversionError, and anything OpenCV lets through
     ++counters_.invalid;
-    warnThrottled("convert", std::string("cannot convert the input set at ") +
-                                 stampText(match.image_stamp) + ": " + e.what() +
-                                 "; frame skipped");
+    warnThrottled("input set", "convert",
+                  std::string("cannot convert the input set at ") + stampText(match.image_stamp) +
+                      ": " + e.what() + "; frame skipped");
     return;
   }
   if (cloud.cloud.empty()) {
     ++counters_.invalid;
-    warnThrottled(std::string(kCloud) + "nan",
+    warnThrottled(kCloud, "nan",
                   topicName(kCloud) + ": none of the " + std::to_string(cloud.total_points) +
                       " points of the sweep at " + stampText(match.sweep_stamp) +
                       " is finite (all NaN / inf); frame skipped");
     return;
   }
-  bool rings_recovered = false;
-  int rings = 0;
-  if (!cloud.has_ring || !hasRings(cloud.cloud)) {
-    rings = recoverRingsByElevation(cloud.cloud, node_params_.num_rings);
-    rings_recovered = true;
-  } else {
-    int max_ring = 0;
-    for (const auto& p : cloud.cloud) max_ring = std::max(max_ring, p.ring);
-    rings = max_ring + 1;
+  // The ring field if plausible, else the offline sweep-order rule, else elevation; each checked.
+  const RingRecovery rings = ensureRings(cloud.cloud, cloud.has_ring, node_params_.num_rings);
+  if (!rings.plausible) {
+    warnThrottled(kCloud, "rings",
+                  topicName(kCloud) + ": no plausible scan lines in the sweep at " +
+                      stampText(match.sweep_stamp) + " (" + rings.fallbacks + "); using " +
+                      std::to_string(rings.rings) + " rings by " + ringSourceName(rings.source) +
+                      ", the prior will be coarse (publish the driver's ring field, or set "
+                      "~num_rings to the sensor's beam count)");
   }
   input.cloud = std::move(cloud.cloud);
   const double conversion_ms = msSince(conversion_start);
@@ -557,22 +598,21 @@ void FusionWorker::processMatch(const Match& match, FusionPipeline& pipeline) {
     result = pipeline.process(input);
   } catch (const std::exception& e) {
     ++counters_.errors;
-    warnThrottled("process",
-                  "fusion failed on the frame at " + stampText(match.image_stamp) + ": " +
-                      e.what() + "; frame skipped",
-                  true);
+    logThrottled(Level::kError, "pipeline", "error",
+                 "fusion failed on the frame at " + stampText(match.image_stamp) + ": " + e.what() +
+                     "; frame skipped");
     return;
   }
   ROS_DEBUG_STREAM("[" << name_ << "] processed " << stampText(match.image_stamp) << " in "
                        << result.stats.total_ms << " ms");
   publishOutputs(match, input.camera, input.left, result, pipeline.params(),
-                 static_cast<int>(input.cloud.size()), rings, rings_recovered, conversion_ms);
+                 static_cast<int>(input.cloud.size()), rings, conversion_ms);
 }
 
 void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera,
                                   const cv::Mat& left_image, const FusionResult& result,
-                                  const FusionParams& params, int cloud_points, int rings,
-                                  bool rings_recovered, double conversion_ms) {
+                                  const FusionParams& params, int cloud_points,
+                                  const RingRecovery& rings, double conversion_ms) {
   const auto out_start = Clock::now();
   const std_msgs::Header& header = match.images.left->header;
   cv::Mat1f depth = result.depth;
@@ -580,7 +620,7 @@ void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera
     depth = disparityToDepth(result.disparity, camera);
 
   stereo_msgs::DisparityImagePtr disparity_msg;
-  sensor_msgs::ImagePtr depth_msg, prior_msg, disparity_image_msg;
+  sensor_msgs::ImagePtr depth_msg, prior_msg, disparity_image_msg, confidence_msg;
   sensor_msgs::CameraInfoPtr depth_info;
   sensor_msgs::PointCloud2Ptr points_msg;
   if (pub_disparity_.getNumSubscribers() > 0) {
@@ -603,6 +643,13 @@ void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera
         result.prior.empty() ? cv::Mat1f::zeros(camera.height, camera.width) : result.prior;
     prior_msg = conversions::floatImageToMsg(prior, header);
   }
+  if (pub_confidence_.getNumSubscribers() > 0) {
+    // Empty for methods without LiDAR: all 0 (= no prior), so the topic always has a message.
+    const cv::Mat1f confidence = result.confidence.empty()
+                                     ? cv::Mat1f::zeros(camera.height, camera.width)
+                                     : result.confidence;
+    confidence_msg = conversions::floatImageToMsg(confidence, header);
+  }
   if (pub_points_.getNumSubscribers() > 0) {
     cv::Mat1f clipped = depth;
     if (node_params_.max_output_depth > 0.0) {
@@ -621,9 +668,15 @@ void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera
   if (depth_info) pub_depth_info_.publish(depth_info);
   if (disparity_image_msg) pub_disparity_image_.publish(disparity_image_msg);
   if (prior_msg) pub_lidar_disparity_.publish(prior_msg);
+  if (confidence_msg) pub_confidence_.publish(confidence_msg);
   if (points_msg) pub_points_.publish(points_msg);
   const uint32_t processed = ++counters_.processed;
-  const double latency_ms = (publish_time - match.image_stamp).toSec() * 1e3;
+  // Latency = publish time - image stamp in ROS time; when ROS time went back since the set
+  // arrived (a bag loop), the arrival's latency plus the wall time since then.
+  const double latency_ms = publish_time >= match.images.arrival_ros
+                                ? (publish_time - match.image_stamp).toSec() * 1e3
+                                : (match.images.arrival_ros - match.image_stamp).toSec() * 1e3 +
+                                      msSince(match.images.arrival_wall);
 
   if (pub_stats_.getNumSubscribers() > 0) {
     StatsReport r;
@@ -641,8 +694,10 @@ void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera
     r.points_in_front = s.points_in_front;
     r.points_projected = s.points_projected;
     r.points_removed = s.points_removed;
-    r.rings = rings;
-    r.rings_recovered = rings_recovered;
+    r.rings = rings.rings;
+    r.rings_recovered = rings.source != RingSource::kField;
+    r.ring_method = ringSourceName(rings.source);
+    r.rings_plausible = rings.plausible;
     r.prior_coverage = static_cast<float>(s.prior_coverage);
     r.output_coverage = static_cast<float>(s.output_coverage);
     r.processed_frames = processed;
@@ -652,6 +707,7 @@ void FusionWorker::publishOutputs(const Match& match, const StereoCamera& camera
     r.invalid_inputs = counters_.invalid;
     r.out_of_order = counters_.out_of_order;
     r.processing_errors = counters_.errors;
+    r.rate_limited = counters_.rate_limited;
     publishStats(pub_stats_, header, r);
   }
 
@@ -717,6 +773,7 @@ void FusionWorker::diagnoseProcessing(diagnostic_updater::DiagnosticStatusWrappe
   stat.add("invalid inputs", counters_.invalid.load());
   stat.add("out of order", counters_.out_of_order.load());
   stat.add("processing errors", counters_.errors.load());
+  stat.add("rate limited (max_rate)", counters_.rate_limited.load());
 }
 
 }  // namespace lidar_stereo_fusion

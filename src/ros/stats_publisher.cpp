@@ -31,6 +31,8 @@ void publishStats(const ros::Publisher& publisher, const std_msgs::Header& heade
   msg->points_removed = r.points_removed;
   msg->rings = r.rings;
   msg->rings_recovered = r.rings_recovered;
+  msg->ring_method = r.ring_method;
+  msg->rings_plausible = r.rings_plausible;
   msg->prior_coverage = r.prior_coverage;
   msg->output_coverage = r.output_coverage;
   msg->processed_frames = r.processed_frames;
@@ -40,6 +42,7 @@ void publishStats(const ros::Publisher& publisher, const std_msgs::Header& heade
   msg->invalid_inputs = r.invalid_inputs;
   msg->out_of_order = r.out_of_order;
   msg->processing_errors = r.processing_errors;
+  msg->rate_limited = r.rate_limited;
   publisher.publish(msg);
 }
 

@@ -52,9 +52,9 @@ constexpr double kOutputTimeout = 20.0;  ///< [s] first frame includes pipeline 
 constexpr double kNoOutputWait = 1.5;    ///< [s] > max_sweep_wait + processing of a small frame
 
 /// The output topics, relative to the fusion namespace.
-const std::vector<std::string> kOutputs = {"disparity", "depth",           "depth/camera_info",
-                                           "points2",   "lidar_disparity", "disparity_image",
-                                           "stats"};
+const std::vector<std::string> kOutputs = {
+    "disparity",       "depth",      "depth/camera_info", "points2", "lidar_disparity",
+    "disparity_image", "confidence", "stats"};
 
 /// How one input set is made.
 struct SetSpec {
@@ -505,11 +505,29 @@ TEST_F(FusionNode, B_OneOutputPerInputSetOnEveryTopic) {
     }
     EXPECT_GT(prior_pixels, kWidth * kHeight / 5);
 
+    // The prior's confidence: 32FC1, unitless in [0, 1], the image's size (all 0 while the core
+    // gives none).
+    auto confidence = h().image("confidence");
+    ASSERT_TRUE(confidence);
+    EXPECT_EQ(confidence->encoding, sensor_msgs::image_encodings::TYPE_32FC1);
+    EXPECT_EQ(confidence->width, static_cast<uint32_t>(kWidth));
+    EXPECT_EQ(confidence->height, static_cast<uint32_t>(kHeight));
+    for (std::size_t k = 0; k + 4 <= confidence->data.size(); k += 4) {
+      float v;
+      std::memcpy(&v, &confidence->data[k], 4);
+      if (!(v >= 0.f && v <= 1.f)) {
+        ADD_FAILURE() << "confidence " << v << " outside [0, 1] at byte " << k;
+        break;
+      }
+    }
+
     auto stats = h().stats();
     EXPECT_EQ(stats->method, "fused_bi");
     EXPECT_GT(stats->points_projected, 500);
     EXPECT_EQ(stats->rings, 64);
     EXPECT_FALSE(stats->rings_recovered);
+    EXPECT_EQ(stats->ring_method, "ring_field");
+    EXPECT_TRUE(stats->rings_plausible);
     EXPECT_GT(stats->processed_frames, last_processed);
     EXPECT_GT(stats->total_ms, 0.f);
     EXPECT_GT(stats->latency_ms, 0.f);
@@ -823,6 +841,29 @@ TEST_F(FusionNode, M_MessagesThatOnceCrashedTheManagerAreRejected) {
   EXPECT_TRUE(h().waitForLog(mark, {"left/image_rect_color", "1073741824"}))
       << h().logsSince(mark);
   expectStillProducing("a bgra8 image 2^30 pixels wide");
+}
+
+// Only in fusion_max_rate.test (~max_rate 2 Hz): image sets stamped 0.1 s apart are dropped on
+// arrival except one per 0.45 s (0.9 / max_rate), counted in stats, without a warning.
+TEST_F(FusionNode, MaxRate_FasterSetsAreDroppedAndCounted) {
+  h().subscribeOutputs();
+  ASSERT_TRUE(h().outputsConnected());
+  ASSERT_TRUE(h().inputsSubscribed(true, 10.0));
+  const ros::Time first = h().nextStamp();
+  h().publishSet(SetSpec(), first);
+  ASSERT_TRUE(h().waitForOutputs(first));
+  const uint32_t limited = h().stats()->rate_limited;
+  const std::size_t mark = h().logMark();
+  std::vector<ros::Time> stamps;
+  for (int k = 1; k <= 5; ++k) {
+    stamps.push_back(first + ros::Duration(0.1 * k));
+    h().publishSet(SetSpec(), stamps.back());
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_TRUE(h().waitForOutputs(stamps.back())) << "the set 0.5 s after the first is let through";
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(h().outputsAfter(stamps[k], 0.0), 0) << "set " << k + 1;
+  EXPECT_EQ(h().stats()->rate_limited, limited + 4);
+  EXPECT_FALSE(h().waitForLog(mark, {"max_rate"}, 0.5)) << h().logsSince(mark);
 }
 
 // Only in fusion_approx_sync.test: right image and info stamped 4 ms after the left ones.

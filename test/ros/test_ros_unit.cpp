@@ -456,6 +456,12 @@ TEST(FrameMatcher, NoSweepWithinTheOffsetIsUnmatched) {
   EXPECT_TRUE(ev.ready.empty());
   ASSERT_EQ(ev.unmatched.size(), 1u);
   EXPECT_EQ(ev.unmatched[0], ros::Time(10.0));
+  EXPECT_FALSE(ev.unmatched_waited.at(0)) << "a later sweep came: max_time_offset, not the wait";
+  // Nothing at or after the set within the wait: decided by max_sweep_wait.
+  m.addImages(ros::Time(11.0), 101, now);
+  ev = m.poll(now + ros::Duration(0.5));
+  ASSERT_EQ(ev.unmatched.size(), 1u);
+  EXPECT_TRUE(ev.unmatched_waited.at(0));
   EXPECT_EQ(m.pendingCount(), 0u);
 }
 

@@ -47,6 +47,9 @@ class FrameMatcher {
   struct Events {
     std::vector<Match> ready;          ///< matched sets, oldest first
     std::vector<ros::Time> unmatched;  ///< image stamps given up: no sweep within max_time_offset
+    /// Per entry of `unmatched`: true when it was decided by waiting (max_wait or max_pending)
+    /// with no sweep at or after it yet, false when a later sweep had come and none was near.
+    std::vector<bool> unmatched_waited;
     bool out_of_order = false;  ///< the message passed in was not newer than the last one (dropped)
     bool restarted = false;     ///< time restarted (see Params::restart_step): buffers were cleared
     std::size_t discarded = 0;  ///< image sets still waiting that the restart threw away
@@ -131,6 +134,7 @@ class FrameMatcher {
         events.ready.push_back({std::move(p.images), best->second, p.stamp, best->first});
       } else {
         events.unmatched.push_back(p.stamp);
+        events.unmatched_waited.push_back(!later_sweep_seen);
       }
       pending_.pop_front();
     }

@@ -6,7 +6,8 @@
 //   out: disparity (stereo_msgs/DisparityImage), depth + depth/camera_info (32FC1 [m], NaN = none),
 //        points2 (PointCloud2 x, y, z, rgb), lidar_disparity (the up-sampled prior, 32FC1 [px],
 //        0 = empty), disparity_image (the disparity as a plain 32FC1 image [px], 0 = none, for
-//        RViz's Image display, which cannot show a DisparityImage), stats
+//        RViz's Image display, which cannot show a DisparityImage), confidence (32FC1 in [0, 1],
+//        the LiDAR prior's confidence, 0 = no prior; all 0 for methods without LiDAR), stats
 //        (lidar_stereo_fusion/FusionStats), plus /diagnostics.
 // Every output is in the left optical frame and stamped with the left image stamp.
 //
@@ -16,9 +17,9 @@
 // some output has a subscriber.
 //
 // Bad input never stops the node: every rejected message or skipped frame is counted (FusionStats,
-// diagnostics) and logged at most once per 5 s per topic and problem, naming both. When time
-// restarts (the ROS clock or a stamp jumps back by more than 1 s: a bag played with --loop) the
-// buffers are cleared instead of counting everything as out of order.
+// diagnostics) and logged at most once per 5 s per topic and kind of problem, naming both. When
+// time restarts (the ROS clock or a stamp jumps back by more than 1 s: a bag played with --loop)
+// the buffers are cleared instead of counting everything as out of order.
 #pragma once
 
 #include <atomic>
@@ -51,6 +52,7 @@
 #include <boost/thread/recursive_mutex.hpp>
 
 #include "lidar_stereo_fusion/FusionConfig.h"
+#include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/ros/frame_matcher.h"
 
@@ -67,6 +69,9 @@ struct NodeParams {
   int num_rings = 64;             ///< rings recovered by elevation for clouds without `ring`
   int cloud_stride = 1;           ///< points2 keeps every k-th pixel in rows and columns
   double max_output_depth = 0.0;  ///< [m] depth / points2 beyond this are empty (0 = no limit)
+  /// [Hz] image sets stamped closer than 0.9 / max_rate after the last accepted one are dropped on
+  /// arrival, counted (FusionStats.rate_limited) and not warned about. 0 = no limit.
+  double max_rate = 0.0;
   /// Nice increment of the worker thread (and so of the OpenMP threads it starts): the pipeline
   /// uses every core, and ROS callbacks, nodelet bond heartbeats and drivers in the same machine
   /// must still be served on time. 0 = same priority as the callbacks.
@@ -103,6 +108,8 @@ class FusionWorker {
   struct ImageSet {
     ImageConstPtr left, right;
     InfoConstPtr left_info, right_info;
+    ros::Time arrival_ros;           ///< ROS time when the set was complete
+    Clock::time_point arrival_wall;  ///< the same in wall time (latency across a bag loop)
   };
   using Matcher = FrameMatcher<ImageSet, CloudConstPtr>;
   using Match = Matcher::Match;
@@ -110,7 +117,7 @@ class FusionWorker {
   /// Cumulative counters (also published in FusionStats).
   struct Counters {
     std::atomic<uint32_t> processed{0}, dropped{0}, unmatched{0}, tf_failures{0}, invalid{0},
-        out_of_order{0}, errors{0};
+        out_of_order{0}, errors{0}, rate_limited{0};
   };
 
   // Setup and lazy subscription.
@@ -135,15 +142,21 @@ class FusionWorker {
   void processMatch(const Match& match, FusionPipeline& pipeline);
   void publishOutputs(const Match& match, const StereoCamera& camera, const cv::Mat& left_image,
                       const FusionResult& result, const FusionParams& params, int cloud_points,
-                      int rings, bool rings_recovered, double conversion_ms);
+                      const RingRecovery& rings, double conversion_ms);
 
   // Diagnostics.
   void diagnoseOutput(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseProcessing(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
-  /// Logs `text` at most once per kThrottlePeriod for each `key` (topic + problem), so that one
-  /// problem does not hide another.
-  void warnThrottled(const std::string& key, const std::string& text, bool error = false);
+  /// Logs `text` at most once per kThrottlePeriod for each (`topic`, `kind`) -- the kind of
+  /// problem, a fixed word, never text that varies -- so that one problem does not hide another
+  /// and the key set stays bounded.
+  enum class Level { kInfo, kWarn, kError };
+  void logThrottled(Level level, const std::string& topic, const std::string& kind,
+                    const std::string& text);
+  void warnThrottled(const std::string& topic, const std::string& kind, const std::string& text) {
+    logThrottled(Level::kWarn, topic, kind, text);
+  }
   std::string topicName(const std::string& relative) const;
 
   ros::NodeHandle nh_, pnh_;
@@ -166,7 +179,7 @@ class FusionWorker {
   // next to the image (camera_info), not under it.
   image_transport::Publisher pub_depth_;
   ros::Publisher pub_depth_info_;
-  image_transport::Publisher pub_lidar_disparity_, pub_disparity_image_;
+  image_transport::Publisher pub_lidar_disparity_, pub_disparity_image_, pub_confidence_;
 
   // TF (own listener thread).
   tf2_ros::Buffer tf_buffer_;
@@ -179,6 +192,7 @@ class FusionWorker {
   boost::optional<Match> next_job_;
   bool stop_ = false;
   ros::Time last_clock_;
+  ros::Time last_accepted_stamp_;  ///< of the last image set let through by max_rate
 
   // Parameters (params_mutex_); the worker applies pending ones before its next frame.
   std::mutex params_mutex_;
@@ -199,7 +213,7 @@ class FusionWorker {
   uint32_t diag_last_problems_ = 0;
 
   std::mutex log_mutex_;
-  std::map<std::string, ros::WallTime> last_log_;
+  std::map<std::string, ros::WallTime> last_log_;  ///< (topic, kind) -> last time logged
 
   std::thread worker_;  ///< last member: started after everything else exists
 };

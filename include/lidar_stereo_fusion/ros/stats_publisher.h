@@ -22,9 +22,11 @@ struct StatsReport {
   int32_t points_in_cloud = 0, points_in_front = 0, points_projected = 0, points_removed = 0;
   int32_t rings = 0;
   bool rings_recovered = false;
+  std::string ring_method;
+  bool rings_plausible = true;
   float prior_coverage = 0, output_coverage = 0;
   uint32_t processed_frames = 0, dropped_frames = 0, unmatched_frames = 0, tf_failures = 0;
-  uint32_t invalid_inputs = 0, out_of_order = 0, processing_errors = 0;
+  uint32_t invalid_inputs = 0, out_of_order = 0, processing_errors = 0, rate_limited = 0;
 };
 
 /// Advertises `topic` (FusionStats) on `nh` with `status_cb` as connect and disconnect callback.
