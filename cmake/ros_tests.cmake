@@ -22,7 +22,7 @@ endif()
 
 # Synthetic street frames as ROS messages, shared by the rostest nodes.
 add_library(${PROJECT_NAME}_ros_test_input STATIC EXCLUDE_FROM_ALL test/ros/synthetic_input.cpp)
-target_link_libraries(${PROJECT_NAME}_ros_test_input PUBLIC ${PROJECT_NAME}_ros)
+target_link_libraries(${PROJECT_NAME}_ros_test_input PUBLIC ${PROJECT_NAME}_ros ${PROJECT_NAME}_sim)
 
 # A rostest gtest node built by `tests` (catkin_make run_tests) after the nodelet and the node.
 function(lsf_add_ros_test_node target)

@@ -305,6 +305,7 @@ CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg) {
     throw ConversionError("cloud of " + std::to_string(total) + " points is too large");
   }
   out.total_points = static_cast<int>(total);
+  if (total == 0) return out;  // data may be empty: no pointer arithmetic on it
   out.cloud.reserve(out.total_points);
   for (uint32_t row = 0; row < msg.height; ++row) {
     const uint8_t* row_ptr = msg.data.data() + static_cast<size_t>(row) * msg.row_step;

@@ -292,35 +292,36 @@ void FusionWorker::detectClockJump() {
 }
 
 bool FusionWorker::checkImageSet(const ImageSet& set) {
-  const auto reject = [this](const std::string& topic, const std::string& problem,
+  // `kind`: a fixed word per kind of problem, the throttle key with the topic.
+  const auto reject = [this](const std::string& topic, const char* kind, const std::string& problem,
                              const ros::Time& stamp) {
     ++counters_.invalid;
     warnThrottled(
-        topic, "invalid",
+        topic, kind,
         topicName(topic) + ": " + problem + " (stamp " + stampText(stamp) + "); image set skipped");
     return false;
   };
   const ros::Time stamp = set.left->header.stamp;
   std::string problem = conversions::checkImage(*set.left);
-  if (!problem.empty()) return reject(kLeftImage, problem, stamp);
+  if (!problem.empty()) return reject(kLeftImage, "image", problem, stamp);
   problem = conversions::checkImage(*set.right);
-  if (!problem.empty()) return reject(kRightImage, problem, stamp);
+  if (!problem.empty()) return reject(kRightImage, "image", problem, stamp);
   if (set.left->width != set.right->width || set.left->height != set.right->height) {
-    return reject(kRightImage,
+    return reject(kRightImage, "size",
                   "size " + std::to_string(set.right->width) + "x" +
                       std::to_string(set.right->height) + " differs from the left image's " +
                       std::to_string(set.left->width) + "x" + std::to_string(set.left->height),
                   stamp);
   }
   if (set.left_info->width != set.left->width || set.left_info->height != set.left->height) {
-    return reject(kLeftInfo,
+    return reject(kLeftInfo, "size",
                   "camera_info is " + std::to_string(set.left_info->width) + "x" +
                       std::to_string(set.left_info->height) + " but the image is " +
                       std::to_string(set.left->width) + "x" + std::to_string(set.left->height),
                   stamp);
   }
   if (set.right_info->width != set.right->width || set.right_info->height != set.right->height) {
-    return reject(kRightInfo,
+    return reject(kRightInfo, "size",
                   "camera_info is " + std::to_string(set.right_info->width) + "x" +
                       std::to_string(set.right_info->height) + " but the image is " +
                       std::to_string(set.right->width) + "x" + std::to_string(set.right->height),
@@ -329,10 +330,11 @@ bool FusionWorker::checkImageSet(const ImageSet& set) {
   try {
     conversions::stereoCameraFromInfo(*set.left_info, *set.right_info);
   } catch (const conversions::ConversionError& e) {
-    return reject(kRightInfo, e.what(), stamp);
+    return reject(kRightInfo, "calibration", e.what(), stamp);
   }
   if (set.left->header.frame_id.empty()) {
-    return reject(kLeftImage, "empty frame_id (the left optical frame is needed for TF)", stamp);
+    return reject(kLeftImage, "frame_id",
+                  "empty frame_id (the left optical frame is needed for TF)", stamp);
   }
   return true;
 }
@@ -390,13 +392,19 @@ void FusionWorker::cloudCb(const CloudConstPtr& cloud) {
   ROS_DEBUG_STREAM("[" << name_ << "] sweep " << stampText(stamp) << " ("
                        << static_cast<uint64_t>(cloud->width) * cloud->height << " points)");
   std::string problem = conversions::checkCloudLayout(*cloud);
-  if (problem.empty() && (cloud->width == 0 || cloud->height == 0))
+  const char* kind = "layout";  // the throttle key with the topic
+  if (problem.empty() && (cloud->width == 0 || cloud->height == 0)) {
     problem = "empty cloud (0 points)";
-  if (problem.empty() && cloud->header.frame_id.empty()) problem = "empty frame_id";
+    kind = "empty";
+  }
+  if (problem.empty() && cloud->header.frame_id.empty()) {
+    problem = "empty frame_id";
+    kind = "frame_id";
+  }
   if (!problem.empty()) {
     ++counters_.invalid;
     warnThrottled(
-        kCloud, "invalid",
+        kCloud, kind,
         topicName(kCloud) + ": " + problem + " (stamp " + stampText(stamp) + "); sweep skipped");
     return;
   }

@@ -94,6 +94,18 @@ TEST(FuzzSeeds, AutowareCalibration) {
       "ReprojectionError: 0.5\nDistModel: plumb_bob\n" +
       matrix("CalibData", 2, 5, "640, 360, 12, 0, 0, 700, 400, 10, -1, -0.5");
   writeSeed("autoware_calib", "synthetic", text);
+  // Found by fuzz_autoware_calib: OpenCV allocated rows x cols before reading the data (86 GB).
+  const std::string huge =
+      "%YAML:1.0\n---\n" + matrix("CameraExtrinsicMat", 2000000000, 40, "1, 2, 3");
+  writeSeed("autoware_calib", "huge_matrix", huge);
+  try {
+    readAutowareCalibration((seedDir("autoware_calib") / "huge_matrix").string());
+    ADD_FAILURE() << "a 2000000000x40 matrix with 3 values was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("declares 2000000000x40 but has 3 values"),
+              std::string::npos)
+        << e.what();
+  }
   const auto calib = readAutowareCalibration((seedDir("autoware_calib") / "synthetic").string());
   EXPECT_EQ(calib.image_size, cv::Size(1280, 720));
   EXPECT_EQ(calib.calib_data.size(), 2u);

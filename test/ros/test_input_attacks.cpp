@@ -66,6 +66,17 @@ TEST(InputAttacks, FieldOffsetNearTwoToThe32IsRejected) {
   EXPECT_THROW(conv::cloudFromMsg(msg), conv::ConversionError);
 }
 
+// Found by fuzz_pointcloud2: a cloud with width 0 and height > 0 stepped a null data pointer.
+TEST(InputAttacks, EmptyCloudWithRowsAndNoDataIsEmpty) {
+  auto msg = cloudWithField("intensity", 12);
+  msg.width = 0;
+  msg.height = 5;
+  msg.row_step = 220;
+  msg.data.clear();
+  EXPECT_EQ(conv::checkCloudLayout(msg), "");
+  EXPECT_TRUE(conv::cloudFromMsg(msg).cloud.empty());
+}
+
 // Crash 2: width 2^30 bgra8, height 1, step 1: width * 4 wrapped to 0 in 32 bits, the check
 // passed and the cv::Exception that followed was not caught (terminate).
 TEST(InputAttacks, ImageWidthThatWrapsWidthTimesChannelsIsRejected) {
