@@ -21,16 +21,16 @@ std::string where(const std::string& path, const std::string& key) {
 /// `node >> cv::Mat` with the checks OpenCV leaves out: it allocates rows x cols before it looks at
 /// the data, so "rows: 2000000000" would allocate gigabytes; and its exceptions become ours.
 cv::Mat readOpenCvMatrix(const cv::FileNode& node, const std::string& what) {
-  if (node.isMap()) {
-    const cv::FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
-    if (rows.isInt() && cols.isInt()) {
-      const long long r = static_cast<int>(rows), c = static_cast<int>(cols);
-      const long long values = data.isSeq() ? static_cast<long long>(data.size()) : 0;
-      if (r < 0 || c < 0 || r * c > values) {
-        throw std::runtime_error(what + " declares " + std::to_string(r) + "x" + std::to_string(c) +
-                                 " but has " + std::to_string(values) + " values");
-      }
-    }
+  const cv::FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
+  // Without rows or cols OpenCV makes up a size (one fuzz input asked for 86 GB).
+  if (!node.isMap() || !rows.isInt() || !cols.isInt() || !data.isSeq()) {
+    throw std::runtime_error(what + " is not an opencv-matrix (rows, cols and data needed)");
+  }
+  const long long r = static_cast<int>(rows), c = static_cast<int>(cols);
+  const long long values = static_cast<long long>(data.size());
+  if (r < 0 || c < 0 || r * c > values) {
+    throw std::runtime_error(what + " declares " + std::to_string(r) + "x" + std::to_string(c) +
+                             " but has " + std::to_string(values) + " values");
   }
   cv::Mat m;
   try {

@@ -98,6 +98,9 @@ TEST(FuzzSeeds, AutowareCalibration) {
   const std::string huge =
       "%YAML:1.0\n---\n" + matrix("CameraExtrinsicMat", 2000000000, 40, "1, 2, 3");
   writeSeed("autoware_calib", "huge_matrix", huge);
+  writeSeed("autoware_calib", "no_rows",
+            "%YAML:1.0\n---\nDistCoeff: !!opencv-matrix\n   rows:`1\n   cols: 5\n   dt: d\n"
+            "   data: [ 0.1, -0.05, 0.001, 0.002, 0.01 ]\n");
   try {
     readAutowareCalibration((seedDir("autoware_calib") / "huge_matrix").string());
     ADD_FAILURE() << "a 2000000000x40 matrix with 3 values was accepted";
