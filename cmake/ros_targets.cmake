@@ -12,7 +12,9 @@ set(LSF_ROS_INCLUDE_DIRS
 add_library(${PROJECT_NAME}_ros
   src/ros/conversions.cpp
   src/ros/ros_params.cpp
-  src/ros/stats_publisher.cpp
+  src/ros/node_support.cpp
+  src/ros/input_gate.cpp
+  src/ros/output_publisher.cpp
   src/ros/fusion_worker.cpp
   src/ros/fusion_nodelet.cpp)
 target_include_directories(${PROJECT_NAME}_ros PUBLIC

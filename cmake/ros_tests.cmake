@@ -14,7 +14,8 @@ set(LSF_ROS_TEST_DEFINITIONS
   LSF_DATA_DIR="${LSF_DATA_DIR}" LSF_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
   LSF_BINARY_DIR="${CMAKE_CURRENT_BINARY_DIR}")
 
-catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp test/ros/test_input_attacks.cpp)
+catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp test/ros/test_input_attacks.cpp
+  test/ros/test_node_parts.cpp)
 if(TARGET test_ros_unit)
   target_link_libraries(test_ros_unit ${PROJECT_NAME}_ros ${GTEST_MAIN_LIBRARIES})
   target_compile_definitions(test_ros_unit PRIVATE ${LSF_ROS_TEST_DEFINITIONS})
