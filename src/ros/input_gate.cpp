@@ -166,6 +166,7 @@ void InputGate::detectClockJump() {
   const ros::Time now = ros::Time::now();
   if (!last_clock_.isZero() && now + ros::Duration(0.5) < last_clock_) {
     counters_.dropped += static_cast<uint32_t>(matcher_.clear());
+    ++clock_epoch_;
     log_.log(ThrottledLog::Level::kInfo, "clock", "jump",
              "ROS time jumped back from " + stampText(last_clock_) + " to " + stampText(now) +
                  ": sweep and image buffers cleared (bag loop?)");
@@ -187,8 +188,14 @@ void InputGate::imageCb(const sensor_msgs::ImageConstPtr& left,
       return;
     }
   }
-  ImageSet set{
-      left, right, left_info, right_info, ros::Time::now(), std::chrono::steady_clock::now()};
+  ImageSet set;
+  set.left = left;
+  set.right = right;
+  set.left_info = left_info;
+  set.right_info = right_info;
+  set.arrival_ros = ros::Time::now();
+  set.arrival_wall = std::chrono::steady_clock::now();
+  set.clock_epoch = clock_epoch_;
   if (const auto rejection = checkImageSet(set)) return reject(*rejection, stamp, "image set");
   std::lock_guard<std::mutex> lock(mutex_);
   detectClockJump();
@@ -237,6 +244,7 @@ void InputGate::handleEvents(InputMatcher::Events& events, const std::string& to
                              const ros::Time& stamp) {
   if (events.restarted) {
     counters_.dropped += static_cast<uint32_t>(events.discarded);
+    ++clock_epoch_;
     std::ostringstream text;
     text << topicName(topic) << ": stamp " << stampText(stamp) << " is more than "
          << matcher_.params().restart_step

@@ -22,8 +22,8 @@ double msSince(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 double latencyMs(const ros::Time& publish_time, const ros::Time& image_stamp,
-                 const ros::Time& arrival_ros, double wall_ms_since_arrival) {
-  if (publish_time >= arrival_ros) return (publish_time - image_stamp).toSec() * 1e3;
+                 const ros::Time& arrival_ros, double wall_ms_since_arrival, bool restarted) {
+  if (!restarted && publish_time >= arrival_ros) return (publish_time - image_stamp).toSec() * 1e3;
   return (arrival_ros - image_stamp).toSec() * 1e3 + wall_ms_since_arrival;
 }
 
@@ -185,8 +185,9 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
   if (confidence_msg) pub_confidence_.publish(confidence_msg);
   if (points_msg) pub_points_.publish(points_msg);
   ++counters_.processed;
-  const double latency_ms = latencyMs(publish_time, match.image_stamp, match.images.arrival_ros,
-                                      msSince(match.images.arrival_wall));
+  const double latency_ms =
+      latencyMs(publish_time, match.image_stamp, match.images.arrival_ros,
+                msSince(match.images.arrival_wall), gate_.clockEpoch() != match.images.clock_epoch);
   if (pub_stats_.getNumSubscribers() > 0) {
     pub_stats_.publish(makeStatsMsg(header, result.stats, report, total_conversion_ms, latency_ms,
                                     (match.sweep_stamp - match.image_stamp).toSec(),

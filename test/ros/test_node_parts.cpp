@@ -129,11 +129,15 @@ TEST(ThrottledLog, OncePerPeriodPerTopicAndKindWithABoundedKeySet) {
 
 TEST(OutputPublisher, LatencyNeverGoesNegativeAfterABagLoop) {
   // Normal: publish time - stamp in ROS time.
-  EXPECT_NEAR(lsf::latencyMs(ros::Time(10.5), ros::Time(10.0), ros::Time(10.1), 400.0), 500.0,
-              1e-6);
+  EXPECT_NEAR(lsf::latencyMs(ros::Time(10.5), ros::Time(10.0), ros::Time(10.1), 400.0, false),
+              500.0, 1e-6);
   // The bag looped while the frame was processed: ROS time is now before the arrival.
-  const double loop = lsf::latencyMs(ros::Time(1.2), ros::Time(10.0), ros::Time(10.1), 400.0);
+  const double loop =
+      lsf::latencyMs(ros::Time(1.2), ros::Time(10.0), ros::Time(10.1), 400.0, false);
   EXPECT_NEAR(loop, 100.0 + 400.0, 1e-6);
+  // ... or looped and came past the arrival again (a short bag at -r 5): the gate saw the restart.
+  EXPECT_NEAR(lsf::latencyMs(ros::Time(10.9), ros::Time(10.0), ros::Time(10.1), 400.0, true), 500.0,
+              1e-6);
 }
 
 TEST(OutputPublisher, StatsComeFromFrameStatsAndACounterSnapshot) {

@@ -38,6 +38,7 @@ struct ImageSet {
   sensor_msgs::CameraInfoConstPtr left_info, right_info;
   ros::Time arrival_ros;                               ///< ROS time when the set was complete
   std::chrono::steady_clock::time_point arrival_wall;  ///< the same in wall time
+  uint32_t clock_epoch = 0;                            ///< InputGate::clockEpoch() at arrival
 };
 using InputMatcher = FrameMatcher<ImageSet, sensor_msgs::PointCloud2ConstPtr>;
 using InputMatch = InputMatcher::Match;
@@ -85,6 +86,9 @@ class InputGate {
   boost::optional<InputMatch> next(std::chrono::milliseconds timeout);
   void stop();
   bool stopped() const { return stopped_; }
+  /// Incremented whenever ROS time or the stamps restart (a bag loop): a set that arrived in an
+  /// earlier epoch cannot measure its latency in ROS time.
+  uint32_t clockEpoch() const { return clock_epoch_; }
 
  private:
   using Image = sensor_msgs::Image;
@@ -125,6 +129,7 @@ class InputGate {
   ros::Time last_clock_;
   bool stop_ = false;
   std::atomic<bool> stopped_{false};
+  std::atomic<uint32_t> clock_epoch_{0};
 };
 
 }  // namespace lidar_stereo_fusion

@@ -42,11 +42,11 @@ struct FrameReport {
   RingRecovery rings;
 };
 
-/// Latency [ms] from the image stamp to `publish_time` (ROS time). When ROS time went back after
-/// the set arrived (a bag loop), the latency at arrival plus the wall time since: never negative
-/// because of a loop.
+/// Latency [ms] from the image stamp to `publish_time` (ROS time). When ROS time restarted after
+/// the set arrived (`restarted`, or publish_time before the arrival: a bag loop), the latency at
+/// arrival plus the wall time since: a loop cannot make it negative or wrong.
 double latencyMs(const ros::Time& publish_time, const ros::Time& image_stamp,
-                 const ros::Time& arrival_ros, double wall_ms_since_arrival);
+                 const ros::Time& arrival_ros, double wall_ms_since_arrival, bool restarted);
 
 /// FusionStats of one frame: the core's FrameStats, the frame report, the latency and the
 /// counters as they are now.
