@@ -24,7 +24,9 @@ double msSince(std::chrono::steady_clock::time_point start) {
 double latencyMs(const ros::Time& publish_time, const ros::Time& image_stamp,
                  const ros::Time& arrival_ros, double wall_ms_since_arrival, bool restarted) {
   if (!restarted && publish_time >= arrival_ros) return (publish_time - image_stamp).toSec() * 1e3;
-  return (arrival_ros - image_stamp).toSec() * 1e3 + wall_ms_since_arrival;
+  // The set may itself have arrived after the restart (its stamp from the old loop, the arrival
+  // time from the new one): then the transport part is unknown, and 0 is the honest lower bound.
+  return std::max(0.0, (arrival_ros - image_stamp).toSec() * 1e3) + wall_ms_since_arrival;
 }
 
 FusionStatsPtr makeStatsMsg(const std_msgs::Header& header, const FrameStats& s,

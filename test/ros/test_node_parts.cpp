@@ -137,6 +137,10 @@ TEST(OutputPublisher, LatencyNeverGoesNegativeAfterABagLoop) {
   EXPECT_NEAR(loop, 100.0 + 400.0, 1e-6);
   // ... or looped and came past the arrival again (a short bag at -r 5): the gate saw the restart.
   EXPECT_NEAR(lsf::latencyMs(ros::Time(10.9), ros::Time(10.0), ros::Time(10.1), 400.0, true), 500.0,
+              1e-6);  // ... or the set of the loop's last frame arrived after the clock had gone
+                      // back (seen live at
+  // -r 5: -3205 ms): its arrival is in the new loop, its stamp in the old one.
+  EXPECT_NEAR(lsf::latencyMs(ros::Time(6.0), ros::Time(10.0), ros::Time(5.0), 1900.0, true), 1900.0,
               1e-6);
 }
 

@@ -44,7 +44,7 @@ struct FrameReport {
 
 /// Latency [ms] from the image stamp to `publish_time` (ROS time). When ROS time restarted after
 /// the set arrived (`restarted`, or publish_time before the arrival: a bag loop), the latency at
-/// arrival plus the wall time since: a loop cannot make it negative or wrong.
+/// arrival (at least 0) plus the wall time since: a loop cannot make it negative.
 double latencyMs(const ros::Time& publish_time, const ros::Time& image_stamp,
                  const ros::Time& arrival_ros, double wall_ms_since_arrival, bool restarted);
 
