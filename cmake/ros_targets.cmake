@@ -12,13 +12,15 @@ set(LSF_ROS_INCLUDE_DIRS
 add_library(${PROJECT_NAME}_ros
   src/ros/conversions.cpp
   src/ros/ros_params.cpp
-  src/ros/stats_publisher.cpp
+  src/ros/node_support.cpp
+  src/ros/input_gate.cpp
+  src/ros/output_publisher.cpp
   src/ros/fusion_worker.cpp
   src/ros/fusion_nodelet.cpp)
 target_include_directories(${PROJECT_NAME}_ros PUBLIC
   $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
 target_include_directories(${PROJECT_NAME}_ros SYSTEM PUBLIC ${LSF_ROS_INCLUDE_DIRS})
-target_link_libraries(${PROJECT_NAME}_ros PUBLIC ${PROJECT_NAME}_core ${catkin_LIBRARIES})
+target_link_libraries(${PROJECT_NAME}_ros PUBLIC ${PROJECT_NAME}_io ${catkin_LIBRARIES})
 # Generated headers (dynamic_reconfigure config, FusionStats message) come first.
 add_dependencies(${PROJECT_NAME}_ros ${PROJECT_NAME}_gencfg ${PROJECT_NAME}_generate_messages_cpp)
 if(catkin_EXPORTED_TARGETS)

@@ -14,7 +14,8 @@ set(LSF_ROS_TEST_DEFINITIONS
   LSF_DATA_DIR="${LSF_DATA_DIR}" LSF_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
   LSF_BINARY_DIR="${CMAKE_CURRENT_BINARY_DIR}")
 
-catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp)
+catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp test/ros/test_input_attacks.cpp
+  test/ros/test_node_parts.cpp)
 if(TARGET test_ros_unit)
   target_link_libraries(test_ros_unit ${PROJECT_NAME}_ros ${GTEST_MAIN_LIBRARIES})
   target_compile_definitions(test_ros_unit PRIVATE ${LSF_ROS_TEST_DEFINITIONS})
@@ -22,7 +23,7 @@ endif()
 
 # Synthetic street frames as ROS messages, shared by the rostest nodes.
 add_library(${PROJECT_NAME}_ros_test_input STATIC EXCLUDE_FROM_ALL test/ros/synthetic_input.cpp)
-target_link_libraries(${PROJECT_NAME}_ros_test_input PUBLIC ${PROJECT_NAME}_ros)
+target_link_libraries(${PROJECT_NAME}_ros_test_input PUBLIC ${PROJECT_NAME}_ros ${PROJECT_NAME}_sim)
 
 # A rostest gtest node built by `tests` (catkin_make run_tests) after the nodelet and the node.
 function(lsf_add_ros_test_node target)
@@ -41,6 +42,7 @@ lsf_add_ros_test_node(test_fusion_node test/ros/test_fusion_node.cpp)
 add_rostest(test/ros/fusion_nodelet.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_node.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_approx_sync.test DEPENDENCIES test_fusion_node)
+add_rostest(test/ros/fusion_max_rate.test DEPENDENCIES test_fusion_node)
 
 # RViz with rviz/fusion.rviz under Xvfb: the fused cloud is drawn (screenshots in the build folder).
 lsf_add_ros_test_node(test_rviz_screenshot test/ros/test_rviz_screenshot.cpp)

@@ -9,7 +9,7 @@
 add_library(${PROJECT_NAME}_calibration_msgs STATIC src/ros/calibration_msgs.cpp)
 target_include_directories(${PROJECT_NAME}_calibration_msgs SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
 target_link_libraries(${PROJECT_NAME}_calibration_msgs PUBLIC
-  ${PROJECT_NAME}_core ${catkin_LIBRARIES})
+  ${PROJECT_NAME}_io ${catkin_LIBRARIES})
 set_target_properties(${PROJECT_NAME}_calibration_msgs PROPERTIES POSITION_INDEPENDENT_CODE ON)
 if(catkin_EXPORTED_TARGETS)
   add_dependencies(${PROJECT_NAME}_calibration_msgs ${catkin_EXPORTED_TARGETS})

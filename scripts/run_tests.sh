@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds the package in a catkin workspace and runs every test:
 # core gtests (exact synthetic answers), data gtests (../shared/data), rostests (node, nodelet,
-# calibration, KITTI bag playback, RViz) and the launch-file check.
+# calibration, KITTI bag playback at several rates, RViz), the launch-file check, and then each
+# libFuzzer target of fuzz/ for a bounded time (scripts/run_fuzz.sh).
 # Usage: bash scripts/run_tests.sh            (from anywhere; the workspace goes to ./ws)
 # Env:   LSF_WS=<dir>       catkin workspace to use (default: <repo>/ws, ignored by git)
 #        LSF_DATA_DIR=<dir> the shared real data (default: <repo>/../shared/data)
 #        CI=true            data tests fail instead of skipping when the data is missing
+#        LSF_FUZZ_SECONDS=N each libFuzzer target runs N s after the tests (default 20; 0 = skip)
+#        LSF_FUZZ_BUILD=<dir> build folder of the fuzz targets (default: <workspace>/build_fuzz)
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -39,8 +42,20 @@ set -e
 
 summary_status=0
 python3 "$ROOT/scripts/summarize_test_results.py" "$WS/build/test_results" || summary_status=$?
+
+# libFuzzer targets (fuzz/), each for a bounded time on the seeds the tests just wrote.
+fuzz_status=0
+if [ "${LSF_FUZZ_SECONDS:-20}" != "0" ]; then
+  LSF_FUZZ_BUILD=${LSF_FUZZ_BUILD:-$WS/build_fuzz} bash "$ROOT/scripts/run_fuzz.sh" \
+    "$WS/build/lidar_stereo_fusion/fuzz_seeds" "${LSF_FUZZ_SECONDS:-20}" || fuzz_status=$?
+fi
+
 if [ $run_status -ne 0 ]; then
   echo "run_tests exited with $run_status" >&2
   exit $run_status
+fi
+if [ $fuzz_status -ne 0 ]; then
+  echo "fuzzing found a problem (see above)" >&2
+  exit $fuzz_status
 fi
 exit $summary_status

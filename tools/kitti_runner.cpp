@@ -2,6 +2,10 @@
 // depth-completion PNGs; optionally scores them against reference depth PNGs or a ring hold-out.
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -45,7 +49,11 @@ Options:
   --frames N           process only the first N frames
   --help               this text
 
-Exit status: 0 on success, 1 on missing or corrupt input, 2 on a bad command line.
+Frames with image_02 but without image_03 or the .bin are named and skipped; a frame that fails
+(corrupt .bin or image, ...) is named and the run goes on with the next one.
+
+Exit status: 0 on success, 1 when any frame failed or on missing or corrupt input (calibration,
+drive, parameters, unwritable output folder), 2 on a bad command line.
 )";
 
 struct Options {
@@ -138,19 +146,80 @@ void saveVisualisation(const fs::path& dir, const std::string& name, const cv::M
   }
 }
 
+/// Fails now, with the reason, when `dir` cannot take files (not after the first frame).
+void requireWritable(const fs::path& dir) {
+  const fs::path probe = dir / (".kitti_runner_probe_" + std::to_string(::getpid()));
+  FILE* file = std::fopen(probe.string().c_str(), "wb");
+  if (file == nullptr) {
+    throw std::runtime_error("cannot write into output folder " + dir.string() + ": " +
+                             std::strerror(errno));
+  }
+  std::fclose(file);
+  fs::remove(probe);
+}
+
+/// Runs one frame and writes its outputs; throws std::runtime_error naming the problem.
+void runFrame(const Options& o, const lsf::kitti::Frame& frame,
+              const lsf::kitti::Calibration& calib, const lsf::FusionParams& params,
+              lsf::FusionPipeline& pipeline, std::vector<lsf::DepthRow>& rows,
+              std::vector<lsf::DepthMetrics>& scores, std::vector<lsf::FrameStats>& stats) {
+  lsf::kitti::FrameData data = lsf::kitti::loadFrame(frame, calib.camera);
+  if (!data.rings.plausible) {
+    std::cerr << "\nkitti_runner: warning: frame " << frame.name << ": rings of " << frame.velodyne
+              << " are implausible (" << data.rings.fallbacks << "); using "
+              << lsf::ringSourceName(data.rings.source) << " (" << data.rings.rings << " rings)\n";
+  }
+  lsf::FusionInput input{data.left, data.right, {}, calib.T_cam_velo, calib.camera};
+  std::optional<cv::Mat1f> reference;
+  if (o.holdout == "even") {
+    lsf::HoldoutCase holdout =
+        lsf::makeRingHoldout(data.cloud, calib.T_cam_velo, calib.camera, params.projection);
+    input.cloud = std::move(holdout.fed);
+    reference = holdout.reference_depth;
+  } else {
+    input.cloud = std::move(data.cloud);
+    reference = referenceOf(o, frame, calib.camera);
+  }
+  lsf::FusionResult result;
+  try {
+    result = pipeline.process(input);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(e.what());
+  }
+  if (result.stats.points_in_front == 0) {
+    throw std::runtime_error("no LiDAR point in front of the camera in " + frame.velodyne +
+                             " (check the sweep and calib_velo_to_cam.txt)");
+  }
+  lsf::kitti::writeDepthPng((fs::path(o.out) / (frame.name + ".png")).string(), result.depth);
+  if (reference) {
+    scores.push_back(lsf::evaluateDepth(result.depth, *reference, calib.camera));
+    rows.push_back({frame.name, scores.back()});
+  }
+  if (o.save_vis) {
+    saveVisualisation(fs::path(o.out) / "vis", frame.name, data.left, result, reference,
+                      calib.camera);
+  }
+  stats.push_back(result.stats);
+}
+
 int run(const Options& o) {
   const lsf::FusionParams params = loadParams(o);
+  // The drive first: a wrong --kitti-raw must be named as such, not as a missing calibration.
+  std::vector<std::string> incomplete;
+  std::vector<lsf::kitti::Frame> frames = lsf::kitti::listFrames(o.drive, &incomplete);
   const lsf::kitti::Calibration calib =
       lsf::kitti::readCalibration(lsf::kitti::calibrationDirOf(o.drive));
-  std::vector<lsf::kitti::Frame> frames = lsf::kitti::listFrames(o.drive);
+  for (const std::string& line : incomplete) {
+    std::cerr << "kitti_runner: warning: skipped " << line << "\n";
+  }
   if (frames.empty()) {
     throw std::runtime_error("no frame in " + o.drive +
                              " has image_02, image_03 and a velodyne_points .bin");
   }
   if (o.frames > 0 && static_cast<size_t>(o.frames) < frames.size()) frames.resize(o.frames);
   createDirectory(o.out);
-  const fs::path vis_dir = fs::path(o.out) / "vis";
-  if (o.save_vis) createDirectory(vis_dir);
+  requireWritable(o.out);
+  if (o.save_vis) createDirectory(fs::path(o.out) / "vis");
 
   std::cerr << "kitti_runner: " << frames.size() << " frames, method "
             << lsf::methodName(params.method)
@@ -159,46 +228,22 @@ int run(const Options& o) {
   std::vector<lsf::DepthRow> rows;
   std::vector<lsf::DepthMetrics> scores;
   std::vector<lsf::FrameStats> stats;
+  std::vector<std::string> failed;
   lsf::ProgressBar progress(std::cerr, static_cast<int>(frames.size()), ::isatty(2) != 0);
   for (size_t i = 0; i < frames.size(); ++i) {
-    const lsf::kitti::Frame& frame = frames[i];
-    progress.update(static_cast<int>(i), frame.name);
-    lsf::kitti::FrameData data = lsf::kitti::loadFrame(frame, calib.camera);
-    lsf::FusionInput input{data.left, data.right, {}, calib.T_cam_velo, calib.camera};
-    std::optional<cv::Mat1f> reference;
-    if (o.holdout == "even") {
-      lsf::HoldoutCase holdout =
-          lsf::makeRingHoldout(data.cloud, calib.T_cam_velo, calib.camera, params.projection);
-      input.cloud = std::move(holdout.fed);
-      reference = holdout.reference_depth;
-    } else {
-      input.cloud = std::move(data.cloud);
-      reference = referenceOf(o, frame, calib.camera);
-    }
-    lsf::FusionResult result;
+    progress.update(static_cast<int>(i), frames[i].name);
     try {
-      result = pipeline.process(input);
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error("frame " + frame.name + ": " + e.what());
+      runFrame(o, frames[i], calib, params, pipeline, rows, scores, stats);
+    } catch (const std::exception& e) {  // name it and go on with the next frame
+      failed.push_back(frames[i].name);
+      std::cerr << "\nkitti_runner: error: frame " << frames[i].name << " failed: " << e.what()
+                << "\n";
     }
-    if (result.stats.points_in_front == 0) {
-      throw std::runtime_error("frame " + frame.name +
-                               ": no LiDAR point in front of the camera in " + frame.velodyne +
-                               " (check the sweep and calib_velo_to_cam.txt)");
-    }
-    lsf::kitti::writeDepthPng((fs::path(o.out) / (frame.name + ".png")).string(), result.depth);
-    if (reference) {
-      scores.push_back(lsf::evaluateDepth(result.depth, *reference, calib.camera));
-      rows.push_back({frame.name, scores.back()});
-    }
-    if (o.save_vis)
-      saveVisualisation(vis_dir, frame.name, data.left, result, reference, calib.camera);
-    stats.push_back(result.stats);
   }
   progress.update(static_cast<int>(frames.size()), "done");
   progress.finish();
 
-  if (!o.reference.empty() && scores.empty()) {
+  if (!o.reference.empty() && scores.empty() && failed.size() < frames.size()) {
     throw std::runtime_error("no frame has a reference PNG in " + o.reference);
   }
   if (!scores.empty()) {
@@ -208,9 +253,16 @@ int run(const Options& o) {
               << (o.holdout == "even" ? "the odd rings (hold-out)" : o.reference) << ":\n\n"
               << lsf::formatDepthTable(rows) << "\n";
   }
-  std::cout << "Time per stage:\n\n" << lsf::formatTimingSummary(stats);
-  std::cout << "Wrote " << frames.size() << " depth PNGs to " << o.out << "\n";
-  return 0;
+  if (!stats.empty()) std::cout << "Time per stage:\n\n" << lsf::formatTimingSummary(stats);
+  std::cout << "Wrote " << stats.size() << " depth PNGs to " << o.out << "\n";
+  if (!failed.empty() || !incomplete.empty()) {
+    std::string names;
+    for (const auto& name : failed) names += " " + name;
+    std::cerr << "kitti_runner: " << failed.size() << " of " << frames.size() << " frames failed"
+              << (failed.empty() ? "" : ":" + names) << "; " << incomplete.size()
+              << " incomplete frames skipped\n";
+  }
+  return failed.empty() ? 0 : 1;
 }
 
 }  // namespace

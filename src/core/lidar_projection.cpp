@@ -197,4 +197,120 @@ bool hasRings(const LidarCloud& cloud) {
   return std::all_of(cloud.begin(), cloud.end(), [](const LidarPoint& p) { return p.ring >= 0; });
 }
 
+std::string ringSourceName(RingSource source) {
+  switch (source) {
+    case RingSource::kField:
+      return "ring_field";
+    case RingSource::kSweepOrder:
+      return "sweep_order";
+    default:
+      return "elevation";
+  }
+}
+
+namespace {
+
+int countRings(const LidarCloud& cloud) {
+  int max_ring = -1;
+  for (const LidarPoint& p : cloud) max_ring = std::max(max_ring, p.ring);
+  return max_ring + 1;
+}
+
+}  // namespace
+
+std::string ringPlausibilityProblem(const LidarCloud& cloud, int max_rings) {
+  const int rings = countRings(cloud);
+  std::size_t with_ring = 0;
+  for (const LidarPoint& p : cloud) with_ring += p.ring >= 0 && isFinite(p) ? 1 : 0;
+  if (with_ring >= 100 && rings < 2) {
+    return std::to_string(rings) + " ring for " + std::to_string(with_ring) + " points";
+  }
+  if (rings > max_rings) {
+    return std::to_string(rings) + " rings, more than " + std::to_string(max_rings);
+  }
+  if (rings < 2) return {};
+  std::vector<std::size_t> count(static_cast<std::size_t>(rings), 0);
+  std::vector<double> elevation_sum(static_cast<std::size_t>(rings), 0.0);
+  for (const LidarPoint& p : cloud) {
+    if (p.ring < 0 || !isFinite(p)) continue;
+    ++count[p.ring];
+    elevation_sum[p.ring] += std::atan2(p.z, std::hypot(p.x, p.y));
+  }
+  const auto sparse =
+      std::count_if(count.begin(), count.end(), [](std::size_t n) { return n < 5; });
+  if (4 * sparse > rings) {
+    return std::to_string(sparse) + " of " + std::to_string(rings) +
+           " rings have fewer than 5 points";
+  }
+  int up = 0, down = 0;
+  double previous = std::numeric_limits<double>::quiet_NaN();
+  for (int r = 0; r < rings; ++r) {
+    if (count[r] == 0) continue;
+    const double mean = elevation_sum[r] / static_cast<double>(count[r]);
+    if (!std::isnan(previous)) (mean > previous ? up : down) += 1;
+    previous = mean;
+  }
+  const int pairs = up + down;
+  if (pairs > 0 && 5 * std::max(up, down) < 4 * pairs) {
+    return "mean elevation per ring is not monotonic in the ring index (" + std::to_string(up) +
+           " steps up, " + std::to_string(down) + " down)";
+  }
+  return {};
+}
+
+RingRecovery ensureRings(LidarCloud& cloud, bool has_ring_field, int num_rings) {
+  if (num_rings < 1) {
+    throw std::invalid_argument("ensureRings: num_rings must be >= 1, got " +
+                                std::to_string(num_rings));
+  }
+  const int max_rings =
+      std::min(2 * num_rings, static_cast<int>(std::numeric_limits<short>::max()));
+  RingRecovery out;
+  const auto note = [&out](const std::string& method, const std::string& problem) {
+    out.fallbacks += (out.fallbacks.empty() ? "" : "; ") + method + ": " + problem;
+  };
+  if (has_ring_field) {
+    if (!hasRings(cloud)) {
+      note("ring field", "points without a valid ring");
+    } else {
+      const std::string problem = ringPlausibilityProblem(cloud, max_rings);
+      if (problem.empty()) {
+        out.source = RingSource::kField;
+        out.rings = countRings(cloud);
+        return out;
+      }
+      note("ring field", problem);
+    }
+  }
+  LidarCloud by_order = cloud;
+  const int order_rings = recoverRingsBySweepOrder(by_order);
+  const std::string order_problem = order_rings > max_rings
+                                        ? std::to_string(order_rings) + " rings, more than " +
+                                              std::to_string(max_rings) + " (not in sweep order)"
+                                        : ringPlausibilityProblem(by_order, max_rings);
+  if (order_problem.empty()) {
+    cloud = std::move(by_order);
+    out.source = RingSource::kSweepOrder;
+    out.rings = order_rings;
+    return out;
+  }
+  note("sweep order", order_problem);
+  out.source = RingSource::kElevation;
+  out.rings = recoverRingsByElevation(cloud, num_rings);
+  std::string problem = ringPlausibilityProblem(cloud, max_rings);
+  std::size_t finite = 0;
+  for (const LidarPoint& p : cloud) finite += isFinite(p) ? 1 : 0;
+  // Elevation binning that finds far fewer beams than the sensor has merged beams (beam origins
+  // that differ, as on the HDL-64E): plausible-looking, but coarse.
+  if (problem.empty() && finite >= 100 && 2 * out.rings < num_rings) {
+    problem = "only " + std::to_string(out.rings) +
+              " of ~num_rings = " + std::to_string(num_rings) + " beams separable by elevation";
+  }
+  if (!problem.empty()) {
+    note("elevation", problem);
+    out.plausible = false;
+  }
+  return out;
+}
+
 }  // namespace lidar_stereo_fusion

@@ -37,4 +37,18 @@ void StereoCamera::validate() const {
   }
 }
 
+std::string baselinePlausibilityProblem(double baseline) {
+  if (baseline >= kMinPlausibleBaseline && baseline <= kMaxPlausibleBaseline) return {};
+  std::string text = "baseline " + std::to_string(baseline) +
+                     " m is outside the plausible range [" + std::to_string(kMinPlausibleBaseline) +
+                     ", " + std::to_string(kMaxPlausibleBaseline) + "] m";
+  if (baseline > kMaxPlausibleBaseline && baseline / 1000.0 <= kMaxPlausibleBaseline) {
+    text += ": is the projection matrix in millimetres? Then the baseline is " +
+            std::to_string(baseline / 1000.0) + " m (Tx = P[3] = -fx * baseline, baseline in m)";
+  } else {
+    text += " (Tx = P[3] = -fx * baseline, baseline in m)";
+  }
+  return text;
+}
+
 }  // namespace lidar_stereo_fusion

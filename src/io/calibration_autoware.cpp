@@ -18,16 +18,34 @@ std::string where(const std::string& path, const std::string& key) {
 
 /// A required !!opencv-matrix node converted to CV_64F with the given size (rows, cols > 0) or,
 /// when rows == 0, any number of rows.
-cv::Mat readMatrix(const cv::FileStorage& fs, const std::string& path, const std::string& key,
-                   int rows, int cols) {
-  const cv::FileNode node = fs[key];
-  if (node.empty()) throw std::runtime_error(where(path, key) + " is missing");
+/// `node >> cv::Mat` with the checks OpenCV leaves out: it allocates rows x cols before it looks at
+/// the data, so "rows: 2000000000" would allocate gigabytes; and its exceptions become ours.
+cv::Mat readOpenCvMatrix(const cv::FileNode& node, const std::string& what) {
+  const cv::FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
+  // Without rows or cols OpenCV makes up a size (one fuzz input asked for 86 GB).
+  if (!node.isMap() || !rows.isInt() || !cols.isInt() || !data.isSeq()) {
+    throw std::runtime_error(what + " is not an opencv-matrix (rows, cols and data needed)");
+  }
+  const long long r = static_cast<int>(rows), c = static_cast<int>(cols);
+  const long long values = static_cast<long long>(data.size());
+  if (r < 0 || c < 0 || r * c > values) {
+    throw std::runtime_error(what + " declares " + std::to_string(r) + "x" + std::to_string(c) +
+                             " but has " + std::to_string(values) + " values");
+  }
   cv::Mat m;
   try {
     node >> m;
   } catch (const cv::Exception&) {
     m.release();
   }
+  return m;
+}
+
+cv::Mat readMatrix(const cv::FileStorage& fs, const std::string& path, const std::string& key,
+                   int rows, int cols) {
+  const cv::FileNode node = fs[key];
+  if (node.empty()) throw std::runtime_error(where(path, key) + " is missing");
+  const cv::Mat m = readOpenCvMatrix(node, where(path, key));
   if (m.empty() || m.channels() != 1) {
     throw std::runtime_error(where(path, key) + " is not an opencv-matrix");
   }
@@ -128,8 +146,7 @@ AutowareCalibration readAutowareCalibration(const std::string& path) {
   }
   const cv::FileNode dist = fs["DistCoeff"];
   if (dist.empty()) throw std::runtime_error(where(path, "DistCoeff") + " is missing");
-  cv::Mat d;
-  dist >> d;
+  const cv::Mat d = readOpenCvMatrix(dist, where(path, "DistCoeff"));
   if (d.empty() || (d.rows != 1 && d.cols != 1)) {
     throw std::runtime_error(where(path, "DistCoeff") + " is not a 1xN opencv-matrix");
   }

@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 
@@ -21,6 +22,8 @@ namespace kitti {
 namespace {
 
 namespace fs = std::filesystem;
+
+constexpr int kHdl64Rings = 64;  ///< KITTI's Velodyne HDL-64E
 
 /// "key: v0 v1 ..." lines of a KITTI calibration file, values kept as text until asked for.
 class KeyValueFile {
@@ -127,8 +130,15 @@ StereoCamera cameraFromProjections(const Eigen::Matrix<double, 3, 4>& p2,
   // P_rect_0i[0, 3] = -fx * b_i with b_i the x position of camera i in the rectified cam-0 frame:
   // b_3 - b_2 = (P2[0, 3] - P3[0, 3]) / fx.
   camera.baseline = (p2(0, 3) - p3(0, 3)) / camera.fx;
-  camera.width = static_cast<int>(std::lround(size[0]));
-  camera.height = static_cast<int>(std::lround(size[1]));
+  // Checked before the conversion: 4294968538 would wrap to 1242 in an int.
+  for (const double v : size) {
+    if (!(v >= 1.0 && v <= 100000.0) || v != std::floor(v)) {
+      throw std::runtime_error("KITTI calibration: " + file + " key 'S_rect_02' is not a size " +
+                               "(two integers in [1, 100000], got " + std::to_string(v) + ")");
+    }
+  }
+  camera.width = static_cast<int>(size[0]);
+  camera.height = static_cast<int>(size[1]);
   if (!(camera.baseline > 0)) {
     throw std::runtime_error("KITTI calibration: " + file +
                              " P_rect_03 is not to the right of P_rect_02 (baseline " +
@@ -136,6 +146,11 @@ StereoCamera cameraFromProjections(const Eigen::Matrix<double, 3, 4>& p2,
   }
   if (camera.width <= 0 || camera.height <= 0) {
     throw std::runtime_error("KITTI calibration: " + file + " key 'S_rect_02' is not a size");
+  }
+  const std::string implausible = baselinePlausibilityProblem(camera.baseline);
+  if (!implausible.empty()) {
+    throw std::runtime_error("KITTI calibration: " + file + " P_rect_02 / P_rect_03 give a " +
+                             implausible);
   }
   return camera;
 }
@@ -148,8 +163,25 @@ std::string requireFile(const fs::path& path, const std::string& what) {
 }
 
 cv::Mat readColorImage(const std::string& path) {
-  cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
+  // IMREAD_COLOR reduces a 16-bit PNG to 8 bits without a word (a 16-bit pair came out as if it
+  // were black): read what is there and scale explicitly.
+  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty()) throw std::runtime_error("KITTI: cannot read image " + path);
+  if (image.depth() == CV_16U) {
+    image.convertTo(image, CV_8U, 255.0 / 65535.0);
+  } else if (image.depth() != CV_8U) {
+    throw std::runtime_error("KITTI: image " + path +
+                             " is neither 8 nor 16 bits per channel (OpenCV depth " +
+                             std::to_string(image.depth()) + ")");
+  }
+  if (image.channels() == 1) {
+    cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
+  } else if (image.channels() == 4) {
+    cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
+  } else if (image.channels() != 3) {
+    throw std::runtime_error("KITTI: image " + path + " has " + std::to_string(image.channels()) +
+                             " channels");
+  }
   return image;
 }
 
@@ -290,7 +322,7 @@ void writeDepthPng(const std::string& path, const cv::Mat1f& depth_m) {
   if (!ok) throw std::runtime_error("KITTI: cannot write depth PNG " + path);
 }
 
-std::vector<Frame> listFrames(const std::string& drive_dir) {
+std::vector<Frame> listFrames(const std::string& drive_dir, std::vector<std::string>* incomplete) {
   const fs::path root(drive_dir);
   const fs::path left_dir = root / "image_02" / "data";
   if (!fs::is_directory(left_dir)) {
@@ -306,10 +338,17 @@ std::vector<Frame> listFrames(const std::string& drive_dir) {
     frame.left_image = entry.path().string();
     frame.right_image = (root / "image_03" / "data" / (name + ".png")).string();
     frame.velodyne = (root / "velodyne_points" / "data" / (name + ".bin")).string();
-    if (fs::is_regular_file(frame.right_image) && fs::is_regular_file(frame.velodyne)) {
+    const bool right = fs::is_regular_file(frame.right_image);
+    const bool velodyne = fs::is_regular_file(frame.velodyne);
+    if (right && velodyne) {
       frames.push_back(frame);
+    } else if (incomplete != nullptr) {
+      incomplete->push_back("frame " + name + ": missing " +
+                            (right ? frame.velodyne : frame.right_image) +
+                            (!right && !velodyne ? " and " + frame.velodyne : ""));
     }
   }
+  if (incomplete != nullptr) std::sort(incomplete->begin(), incomplete->end());
   std::sort(frames.begin(), frames.end(),
             [](const Frame& a, const Frame& b) { return a.name < b.name; });
   return frames;
@@ -333,7 +372,7 @@ FrameData loadFrame(const Frame& frame, const StereoCamera& camera) {
                              std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
   data.cloud = readVelodyneBin(frame.velodyne);
-  recoverRingsBySweepOrder(data.cloud);
+  data.rings = ensureRings(data.cloud, /*has_ring_field=*/false, kHdl64Rings);
   return data;
 }
 

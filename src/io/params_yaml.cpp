@@ -161,6 +161,8 @@ class FieldReader {
   void read(const cv::FileNode& node, const std::string& key, int& value) const {
     if (!node.isInt()) fail(key, "must be an integer");
     value = static_cast<int>(node);
+    // Checked here too (not only in validate()): a thread count beyond this crashes libgomp.
+    if (key == "num_threads" && (value < 0 || value > 256)) fail(key, "must be in [0, 256]");
   }
 
   void read(const cv::FileNode& node, const std::string& key, bool& value) const {
@@ -183,7 +185,8 @@ class FieldReader {
   void read(const cv::FileNode& node, const std::string& key, uint64_t& value) const {
     if (node.isInt()) {
       const int v = static_cast<int>(node);
-      if (v < 0) fail(key, "must be >= 0");
+      // OpenCV reads integers as int: 3000000000 arrives here wrapped to a negative number.
+      if (v < 0) fail(key, "must be >= 0; values above 2147483647 must be quoted (\"3000000000\")");
       value = static_cast<uint64_t>(v);
       return;
     }
@@ -220,8 +223,22 @@ std::string readText(const std::string& path) {
   return buffer.str();
 }
 
+/// Throws when `text` has control bytes other than tab, CR and LF: OpenCV reads a buffer only up
+/// to its first NUL, so binary garbage would otherwise load as an empty file (the defaults).
+void requireText(const std::string& text, const std::string& path) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 && c != '\t' && c != '\n' && c != '\r') {
+      throw std::runtime_error("params YAML " + path + ": not a text file (control byte " +
+                               std::to_string(c) + " at offset " + std::to_string(i) + ")");
+    }
+  }
+}
+
 cv::FileStorage openYaml(const std::string& path) {
-  const std::string text = withYamlDirective(readText(path));
+  const std::string raw = readText(path);
+  requireText(raw, path);
+  const std::string text = withYamlDirective(raw);
   cv::FileStorage fs;
   try {
     fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);

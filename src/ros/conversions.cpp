@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <sstream>
@@ -45,7 +46,14 @@ std::string checkImage(const sensor_msgs::Image& msg) {
             << "' (supported: " << joined(supportedImageEncodings()) << ")";
   } else if (msg.width == 0 || msg.height == 0) {
     problem << "empty image (" << msg.width << "x" << msg.height << ")";
-  } else if (msg.step < msg.width * static_cast<uint32_t>(enc::numChannels(msg.encoding))) {
+  } else if (static_cast<uint64_t>(msg.width) * enc::numChannels(msg.encoding) >
+                 static_cast<uint64_t>(std::numeric_limits<int>::max()) ||
+             msg.height > static_cast<uint32_t>(std::numeric_limits<int>::max())) {
+    // 64-bit arithmetic: width * channels wraps in 32 bits for widths near 2^30.
+    problem << "image of " << msg.width << "x" << msg.height << " " << msg.encoding
+            << " is too large (width * channels and height must fit in an int)";
+  } else if (static_cast<uint64_t>(msg.step) <
+             static_cast<uint64_t>(msg.width) * enc::numChannels(msg.encoding)) {
     problem << "step " << msg.step << " is smaller than width * channels for " << msg.encoding;
   } else if (msg.data.size() < static_cast<size_t>(msg.step) * msg.height) {
     problem << "data has " << msg.data.size() << " bytes, step * height needs "
@@ -62,17 +70,23 @@ cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg) {
     shared = cv_bridge::toCvShare(msg);
   } catch (const cv_bridge::Exception& e) {
     throw ConversionError(std::string("cv_bridge: ") + e.what());
+  } catch (const cv::Exception& e) {
+    throw ConversionError(std::string("cv_bridge (OpenCV): ") + e.what());
   }
   const std::string& e = msg->encoding;
   cv::Mat out;
-  if (e == enc::BGR8 || e == enc::MONO8) {
-    out = shared->image.clone();  // own the pixels: the message may go before the result
-  } else if (e == enc::BGRA8) {
-    cv::cvtColor(shared->image, out, cv::COLOR_BGRA2BGR);
-  } else if (e == enc::RGBA8) {
-    cv::cvtColor(shared->image, out, cv::COLOR_RGBA2BGR);
-  } else {  // rgb8
-    cv::cvtColor(shared->image, out, cv::COLOR_RGB2BGR);
+  try {
+    if (e == enc::BGR8 || e == enc::MONO8) {
+      out = shared->image.clone();  // own the pixels: the message may go before the result
+    } else if (e == enc::BGRA8) {
+      cv::cvtColor(shared->image, out, cv::COLOR_BGRA2BGR);
+    } else if (e == enc::RGBA8) {
+      cv::cvtColor(shared->image, out, cv::COLOR_RGBA2BGR);
+    } else {  // rgb8
+      cv::cvtColor(shared->image, out, cv::COLOR_RGB2BGR);
+    }
+  } catch (const cv::Exception& ex) {  // OpenCV's own checks: never let them escape a callback
+    throw ConversionError(std::string("OpenCV: ") + ex.what());
   }
   return out;
 }
@@ -98,6 +112,14 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
                                   const sensor_msgs::CameraInfo& right) {
   const auto& Pl = left.P;
   const auto& Pr = right.P;
+  for (std::size_t i : {0u, 2u, 3u, 5u, 6u}) {  // the entries used below, of both cameras
+    if (!std::isfinite(Pl[i]) || !std::isfinite(Pr[i])) {
+      throw ConversionError(std::string(std::isfinite(Pl[i]) ? "right" : "left") +
+                            " camera_info: P[" + std::to_string(i) + "] is " +
+                            std::to_string(std::isfinite(Pl[i]) ? Pr[i] : Pl[i]) +
+                            " (not finite); is the camera calibrated?");
+    }
+  }
   if (Pl[0] <= 0.0 || Pl[5] <= 0.0) {
     throw ConversionError("left camera_info: P has no focal length (fx = " + std::to_string(Pl[0]) +
                           ", fy = " + std::to_string(Pl[5]) + "); is the camera calibrated?");
@@ -130,6 +152,11 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
     throw ConversionError(
         "right camera_info: P[3] (Tx = -fx * baseline) is " + std::to_string(Pr[3]) +
         ", equal to the left one: no baseline (is this the right camera's info?)");
+  }
+  const std::string implausible = baselinePlausibilityProblem(camera.baseline);
+  if (!implausible.empty()) {
+    throw ConversionError("right camera_info: P[3] = " + std::to_string(Pr[3]) + " gives a " +
+                          implausible);
   }
   return camera;
 }
@@ -244,7 +271,8 @@ std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg) {
       }
       continue;
     }
-    if (f.offset + static_cast<uint32_t>(size) > msg.point_step) {
+    // 64-bit sum: an offset near 2^32 must not wrap round and pass.
+    if (static_cast<uint64_t>(f.offset) + static_cast<uint64_t>(size) > msg.point_step) {
       problem << "field '" << f.name << "' (offset " << f.offset << ", " << size
               << " bytes) does not fit in point_step " << msg.point_step;
       return problem.str();
@@ -272,7 +300,12 @@ CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg) {
   CloudConversion out;
   out.has_ring = fr.present;
   out.has_time = ft.present;
-  out.total_points = static_cast<int>(msg.width * msg.height);
+  const uint64_t total = static_cast<uint64_t>(msg.width) * msg.height;
+  if (total > static_cast<uint64_t>(std::numeric_limits<int>::max())) {
+    throw ConversionError("cloud of " + std::to_string(total) + " points is too large");
+  }
+  out.total_points = static_cast<int>(total);
+  if (total == 0) return out;  // data may be empty: no pointer arithmetic on it
   out.cloud.reserve(out.total_points);
   for (uint32_t row = 0; row < msg.height; ++row) {
     const uint8_t* row_ptr = msg.data.data() + static_cast<size_t>(row) * msg.row_step;

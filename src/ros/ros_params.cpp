@@ -15,6 +15,8 @@ namespace ros_params {
 
 namespace {
 
+constexpr int kMaxThreads = 256;  ///< as cfg/Fusion.cfg and PatchMatchParams::validate()
+
 /// Calls v(group, field, value&) for every field of FusionParams, in declaration order. The value
 /// types are double, int, bool, Method and uint64_t (the seed). This table is the only place that
 /// lists the fields; the names are those of io/params_yaml.h.
@@ -279,6 +281,14 @@ FusionParams readParams(const ros::NodeHandle& pnh, const FusionParams& base,
   std::vector<std::string>& errs = errors ? *errors : local;
   FusionParams p = base;
   visitParams(p, Reader{pnh, errs});
+  // rosparam and YAML bypass dynamic_reconfigure's range; a thread count beyond it crashes libgomp.
+  if (p.patchmatch.num_threads < 0 || p.patchmatch.num_threads > kMaxThreads) {
+    errs.push_back("parameter " + pnh.resolveName("patchmatch/num_threads") + " = " +
+                   std::to_string(p.patchmatch.num_threads) + " is out of range [0, " +
+                   std::to_string(kMaxThreads) + "] (0 = all cores); keeping " +
+                   std::to_string(base.patchmatch.num_threads));
+    p.patchmatch.num_threads = base.patchmatch.num_threads;
+  }
 
   // Unknown keys under the groups are typos: name them (they would otherwise be ignored).
   std::set<std::string> known;

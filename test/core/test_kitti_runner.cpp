@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -243,6 +244,55 @@ TEST(KittiRunner, MissingOrCorruptInputExitsWith1AndSaysWhat) {
     SyntheticDrive drive;
     fs::remove_all(drive.drive() / "image_03");
     expectFailure(drive, "no frame");
+  }
+}
+
+// Issue 9, points 8 and 10: incomplete frames are named, a failing frame does not stop the run
+// (exit 1 at the end), a wrong drive is named as such, an unwritable output folder fails first.
+TEST(KittiRunner, SkippedAndFailedFramesAreNamedAndTheRunGoesOn) {
+  REQUIRE_RUNNER();
+  {
+    SyntheticDrive drive;
+    fs::remove(drive.drive() / "image_03/data/0000000001.png");
+    const RunResult r = drive.run("--out " + drive.outDir().string() + " --method lidar_bi");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("skipped frame 0000000001: missing"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(drive.outDir() / "0000000000.png"));
+    EXPECT_TRUE(fs::exists(drive.outDir() / "0000000002.png"));
+  }
+  {
+    SyntheticDrive drive;
+    std::ofstream(drive.drive() / "velodyne_points/data/0000000000.bin", std::ios::binary)
+        << "seventeen bytes!!";
+    const RunResult r = drive.run("--out " + drive.outDir().string() + " --method lidar_bi");
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("frame 0000000000 failed"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("1 of 3 frames failed: 0000000000"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(drive.outDir() / "0000000000.png"));
+    EXPECT_TRUE(fs::exists(drive.outDir() / "0000000001.png")) << "the run stopped at frame 0";
+    EXPECT_TRUE(fs::exists(drive.outDir() / "0000000002.png"));
+  }
+  {
+    SyntheticDrive drive;
+    const std::string command =
+        runnerPath() + " --kitti-raw /nonexistent --out " + drive.outDir().string() + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string output;
+    char buffer[256];
+    while (fgets(buffer, sizeof(buffer), pipe) != nullptr) output += buffer;
+    const int raw = pclose(pipe);
+    EXPECT_EQ(WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, 1) << output;
+    EXPECT_NE(output.find("/nonexistent is not a raw drive folder"), std::string::npos) << output;
+    EXPECT_EQ(output.find("calib_cam_to_cam"), std::string::npos) << output;
+  }
+  {
+    SyntheticDrive drive;  // /proc/self exists and takes no files, even as root
+    const RunResult r = drive.run("--out /proc/self --method lidar_bi");
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("cannot write into output folder /proc/self: "), std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("frames, method"), std::string::npos) << "failed only after starting";
   }
 }
 

@@ -41,6 +41,7 @@
 
 #include "data/data_guard.h"
 #include "kitti_bag_expected.h"
+#include "kitti_bag_util.h"
 #include "lidar_stereo_fusion/FusionStats.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 
@@ -57,49 +58,12 @@ const std::vector<std::string> kReplayFrames = {"0000000000", "0000000005", "000
 /// two cores; a frame that never comes out fails the test long before rostest's time limit).
 constexpr double kFrameTimeout = 240.0;
 
-/// Exit status and output (stdout + stderr) of a shell command.
-std::pair<int, std::string> run(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return {-1, "popen failed"};
-  std::array<char, 512> buffer{};
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
+using lidar_stereo_fusion::test::runCommand;
 
-std::string scratchDir() {
-  const fs::path dir = fs::path(LSF_BINARY_DIR) / "test_kitti_bag";
-  fs::create_directories(dir);
-  return dir.string();
-}
+std::string scratchDir() { return lidar_stereo_fusion::test::scratchDir("test_kitti_bag"); }
 
-/// A KITTI raw date folder in the build tree whose drive holds only `frames`: symbolic links to
-/// the shared data (nothing is copied). Returns the drive folder.
 std::string makeSubsetDrive(const std::vector<std::string>& frames) {
-  const fs::path src_date = lidar_stereo_fusion::test::dataPath(kDate);
-  const fs::path src = src_date / kDrive;
-  const fs::path date = fs::path(scratchDir()) / "subset" / "2011_09_26";
-  const fs::path drive = date / kDrive;
-  fs::remove_all(date);
-  for (const char* calib : {"calib_cam_to_cam.txt", "calib_velo_to_cam.txt"}) {
-    fs::create_directories(date);
-    fs::create_symlink(src_date / calib, date / calib);
-  }
-  for (const std::string sensor : {"image_02", "image_03", "velodyne_points"}) {
-    fs::create_directories(drive / sensor / "data");
-    for (const auto& entry : fs::directory_iterator(src / sensor)) {
-      if (entry.path().extension() == ".txt") {
-        fs::create_symlink(entry.path(), drive / sensor / entry.path().filename());
-      }
-    }
-    const std::string ext = sensor == "velodyne_points" ? ".bin" : ".png";
-    for (const std::string& frame : frames) {
-      fs::create_symlink(src / sensor / "data" / (frame + ext),
-                         drive / sensor / "data" / (frame + ext));
-    }
-  }
-  return drive.string();
+  return lidar_stereo_fusion::test::makeSubsetDrive(scratchDir(), frames);
 }
 
 /// Every message of `bag`, grouped by topic, in time order.
@@ -203,7 +167,7 @@ TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
   const std::string bag_path = scratchDir() + "/whole_drive.bag";
   fs::remove(bag_path);
   const auto [status, output] =
-      run(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + drive + " --out " + bag_path);
+      runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + drive + " --out " + bag_path);
   ASSERT_EQ(status, 0) << output;
   // The LiDAR-only frames are named as skipped.
   EXPECT_NE(output.find("0000000016"), std::string::npos) << output;
@@ -330,15 +294,15 @@ TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
 TEST(KittiToBag, BadInputFailsWithoutWritingABag) {
   const std::string bag_path = scratchDir() + "/bad.bag";
   fs::remove(bag_path);
-  auto [status, output] = run(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + scratchDir() +
+  auto [status, output] = runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + scratchDir() +
                               "/no_such_drive --out " + bag_path);
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find("no_such_drive"), std::string::npos) << output;
-  std::tie(status, output) = run(std::string(LSF_KITTI_TO_BAG) + " --out " + bag_path);
+  std::tie(status, output) = runCommand(std::string(LSF_KITTI_TO_BAG) + " --out " + bag_path);
   EXPECT_EQ(status, 2) << output;
   EXPECT_NE(output.find("--kitti-raw"), std::string::npos) << output;
   std::tie(status, output) =
-      run(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw x --out " + bag_path + " --frames -3");
+      runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw x --out " + bag_path + " --frames -3");
   EXPECT_EQ(status, 2) << output;
   EXPECT_FALSE(fs::exists(bag_path));
   EXPECT_FALSE(fs::exists(bag_path + ".partial"));
@@ -350,7 +314,7 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
   const std::string bag_path = scratchDir() + "/replay.bag";
   fs::remove(bag_path);
   const auto [status, output] =
-      run(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + drive + " --out " + bag_path);
+      runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + drive + " --out " + bag_path);
   ASSERT_EQ(status, 0) << output;
 
   rosbag::Bag bag;
@@ -412,7 +376,7 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
   fs::remove_all(runner_out);
   // Same parameter file as the nodelet's (fusion.launch loads config/fusion.yaml).
   const auto [runner_status, runner_output] =
-      run(std::string(LSF_KITTI_RUNNER) + " --kitti-raw " + drive + " --out " + runner_out +
+      runCommand(std::string(LSF_KITTI_RUNNER) + " --kitti-raw " + drive + " --out " + runner_out +
           " --params " + LSF_SOURCE_DIR + "/config/fusion.yaml");
   ASSERT_EQ(runner_status, 0) << runner_output;
 

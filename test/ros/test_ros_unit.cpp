@@ -375,11 +375,10 @@ TEST(Conversions, ColouredCloudPacksRgbLikePcl) {
 
 // --- sweep matching ------------------------------------------------------------------------------
 using Matcher = lsf::FrameMatcher<int, int>;
-using Clock = Matcher::Clock;
 
 TEST(FrameMatcher, SweepStampedAfterTheImageArrivingLater) {
   Matcher m;
-  const auto now = Clock::now();
+  const ros::Time now(100.0);
   auto ev = m.addSweep(ros::Time(9.95), 1, now);  // previous sweep
   ev = m.addImages(ros::Time(10.0), 100, now);
   EXPECT_TRUE(ev.ready.empty()) << "must wait: a later sweep may be nearer";
@@ -391,7 +390,7 @@ TEST(FrameMatcher, SweepStampedAfterTheImageArrivingLater) {
 
 TEST(FrameMatcher, NearestOfBothSidesWithinTheOffset) {
   Matcher m;
-  const auto now = Clock::now();
+  const ros::Time now(100.0);
   m.addSweep(ros::Time(9.85), 1, now);
   m.addImages(ros::Time(10.0), 100, now);
   auto ev = m.addSweep(ros::Time(10.07), 2, now);
@@ -402,7 +401,7 @@ TEST(FrameMatcher, NearestOfBothSidesWithinTheOffset) {
 
 TEST(FrameMatcher, SweepAlreadyThere) {
   Matcher m;
-  const auto now = Clock::now();
+  const ros::Time now(100.0);
   m.addSweep(ros::Time(10.0), 1, now);
   auto ev = m.addImages(ros::Time(10.0), 100, now);
   ASSERT_EQ(ev.ready.size(), 1u);
@@ -413,30 +412,62 @@ TEST(FrameMatcher, EarlierSweepIsTakenAfterWaiting) {
   Matcher::Params p;
   p.max_wait = 0.2;
   Matcher m(p);
-  const auto now = Clock::now();
+  const ros::Time now(100.0);
   m.addSweep(ros::Time(9.95), 1, now);
   EXPECT_TRUE(m.addImages(ros::Time(10.0), 100, now).ready.empty());
-  EXPECT_TRUE(m.poll(now + std::chrono::milliseconds(100)).ready.empty());
-  auto ev = m.poll(now + std::chrono::milliseconds(250));
+  EXPECT_TRUE(m.poll(now + ros::Duration(0.1)).ready.empty());
+  auto ev = m.poll(now + ros::Duration(0.25));
+  ASSERT_EQ(ev.ready.size(), 1u);
+  EXPECT_EQ(ev.ready[0].sweep, 1);
+}
+
+// Issue 9, point 4: under `rosbag play -r 0.05` the sweep stamped 30 ms after the images arrives
+// 0.6 s of wall time later. The wait is in ROS (simulated) time, so the set still gets its own
+// sweep, whatever the playback rate; only ROS time moving past the wait decides it without one.
+TEST(FrameMatcher, WaitIsInRosTimeSoThePlaybackRateDoesNotMatter) {
+  for (const double rate : {0.05, 0.2, 1.0, 5.0}) {
+    SCOPED_TRACE("rate " + std::to_string(rate));
+    Matcher m;  // max_wait 0.3 s, max_time_offset 0.1 s
+    // Sim time = stamps; what wall time passes in between does not enter at all.
+    m.addSweep(ros::Time(9.93), 1, ros::Time(9.93));  // the previous sweep, within the offset
+    EXPECT_TRUE(m.addImages(ros::Time(10.0), 100, ros::Time(10.0)).ready.empty());
+    EXPECT_TRUE(m.poll(ros::Time(10.029)).ready.empty()) << "decided before its sweep came";
+    auto ev = m.addSweep(ros::Time(10.03), 2, ros::Time(10.03));
+    ASSERT_EQ(ev.ready.size(), 1u);
+    EXPECT_EQ(ev.ready[0].sweep, 2) << "paired with the previous sweep";
+  }
+  // A paused bag (sim time stands still) never gives up; time moving past the wait does.
+  Matcher m;
+  m.addSweep(ros::Time(9.95), 1, ros::Time(9.95));
+  m.addImages(ros::Time(10.0), 100, ros::Time(10.0));
+  EXPECT_TRUE(m.poll(ros::Time(10.0)).ready.empty());
+  EXPECT_TRUE(m.poll(ros::Time(10.29)).ready.empty());
+  auto ev = m.poll(ros::Time(10.31));
   ASSERT_EQ(ev.ready.size(), 1u);
   EXPECT_EQ(ev.ready[0].sweep, 1);
 }
 
 TEST(FrameMatcher, NoSweepWithinTheOffsetIsUnmatched) {
   Matcher m;  // max_time_offset 0.1
-  const auto now = Clock::now();
+  const ros::Time now(100.0);
   m.addSweep(ros::Time(9.8), 1, now);
   m.addImages(ros::Time(10.0), 100, now);
   auto ev = m.addSweep(ros::Time(10.15), 2, now);
   EXPECT_TRUE(ev.ready.empty());
   ASSERT_EQ(ev.unmatched.size(), 1u);
   EXPECT_EQ(ev.unmatched[0], ros::Time(10.0));
+  EXPECT_FALSE(ev.unmatched_waited.at(0)) << "a later sweep came: max_time_offset, not the wait";
+  // Nothing at or after the set within the wait: decided by max_sweep_wait.
+  m.addImages(ros::Time(11.0), 101, now);
+  ev = m.poll(now + ros::Duration(0.5));
+  ASSERT_EQ(ev.unmatched.size(), 1u);
+  EXPECT_TRUE(ev.unmatched_waited.at(0));
   EXPECT_EQ(m.pendingCount(), 0u);
 }
 
 TEST(FrameMatcher, OutOfOrderAndDuplicateStampsAreRejected) {
   Matcher m;
-  const auto now = Clock::now();
+  const ros::Time now(100.0);
   EXPECT_FALSE(m.addSweep(ros::Time(10.0), 1, now).out_of_order);
   EXPECT_TRUE(m.addSweep(ros::Time(9.9), 2, now).out_of_order);
   EXPECT_TRUE(m.addSweep(ros::Time(10.0), 3, now).out_of_order);
@@ -449,7 +480,7 @@ TEST(FrameMatcher, OutOfOrderAndDuplicateStampsAreRejected) {
 
 TEST(FrameMatcher, LargeStepBackIsARestartNotDisorder) {
   Matcher m;  // restart_step 1 s
-  const auto now = Clock::now();
+  const ros::Time now(100.0);
   m.addSweep(ros::Time(20.0), 1, now);
   m.addImages(ros::Time(20.0), 100, now);
   m.addImages(ros::Time(20.5), 101, now);            // waits for a later sweep
@@ -472,7 +503,7 @@ TEST(FrameMatcher, TooManyPendingDecidesTheOldest) {
   Matcher::Params p;
   p.max_pending = 2;
   Matcher m(p);
-  const auto now = Clock::now();
+  const ros::Time now(100.0);
   m.addSweep(ros::Time(9.99), 1, now);
   m.addImages(ros::Time(10.0), 100, now);
   m.addImages(ros::Time(10.1), 101, now);
@@ -484,7 +515,7 @@ TEST(FrameMatcher, TooManyPendingDecidesTheOldest) {
 
 TEST(FrameMatcher, SeveralReadyAtOnceOldestFirst) {
   Matcher m;
-  const auto now = Clock::now();
+  const ros::Time now(100.0);
   m.addImages(ros::Time(10.0), 100, now);
   m.addImages(ros::Time(10.05), 101, now);
   auto ev = m.addSweep(ros::Time(10.06), 1, now);

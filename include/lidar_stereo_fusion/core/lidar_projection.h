@@ -2,6 +2,8 @@
 // and recovery of scan-line (ring) indices for clouds that carry none.
 #pragma once
 
+#include <string>
+
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
@@ -57,5 +59,37 @@ int recoverRingsByElevation(LidarCloud& cloud, int num_rings, double min_gap_deg
 
 /// True when every point has ring >= 0.
 bool hasRings(const LidarCloud& cloud);
+
+/// Where the rings of a sweep came from.
+enum class RingSource {
+  kField,       ///< the sensor's ring field, plausible as it was
+  kSweepOrder,  ///< recoverRingsBySweepOrder (KITTI .bin / kitti2bag order)
+  kElevation,   ///< recoverRingsByElevation
+};
+/// "ring_field", "sweep_order" or "elevation".
+std::string ringSourceName(RingSource source);
+
+/// Outcome of ensureRings(): the method used, the rings it found, and why earlier methods were
+/// passed over (empty when the first one was plausible).
+struct RingRecovery {
+  RingSource source = RingSource::kField;
+  int rings = 0;          ///< distinct scan lines (max ring + 1)
+  bool plausible = true;  ///< false: even the last fallback failed the checks (used anyway)
+  std::string fallbacks;  ///< e.g. "ring field: 1 ring for 120000 points; sweep order: ..."
+};
+
+/// Empty when the rings of `cloud` look like a real scan pattern, else what is wrong: fewer than
+/// 2 rings for >= 100 points, more than `max_rings`, more than a quarter of the rings with fewer
+/// than 5 points, or mean elevations per ring that are not (at least 80 % of neighbouring pairs)
+/// monotonic in the ring index. Points with ring < 0 are ignored.
+std::string ringPlausibilityProblem(const LidarCloud& cloud, int max_rings);
+
+/// Makes sure every point has a plausible ring, trying in order: the ring field (when
+/// `has_ring_field` and plausible), the sweep order rule of the offline path, and elevation
+/// binning into at most `num_rings` beams (num_rings is also the most rings accepted from the
+/// other two, times 2: a sensor with more beams than configured is still recognised). Every
+/// recovery is checked with ringPlausibilityProblem(); the result says which method was used and
+/// why the others were not. Throws std::invalid_argument for num_rings < 1.
+RingRecovery ensureRings(LidarCloud& cloud, bool has_ring_field, int num_rings);
 
 }  // namespace lidar_stereo_fusion

@@ -33,6 +33,14 @@ struct StereoCamera {
   void validate() const;
 };
 
+/// Plausible stereo baselines [m]: from a 1 cm micro rig to a 5 m wide truck rig. A value outside
+/// is almost always a unit mistake (a projection matrix written in millimetres gives 1000x).
+constexpr double kMinPlausibleBaseline = 0.01;
+constexpr double kMaxPlausibleBaseline = 5.0;
+/// Empty when `baseline` [m] is in [kMinPlausibleBaseline, kMaxPlausibleBaseline], else a message
+/// naming the value, the range and the likely unit mistake with the value it would then be.
+std::string baselinePlausibilityProblem(double baseline);
+
 /// One LiDAR return in the LiDAR frame.
 struct LidarPoint {
   float x = 0.f, y = 0.f, z = 0.f;  ///< position [m] in the LiDAR frame

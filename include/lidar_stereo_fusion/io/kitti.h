@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/types.h"
 
 namespace lidar_stereo_fusion {
@@ -49,15 +50,23 @@ struct Frame {
   std::string left_image, right_image, velodyne;
 };
 /// Lists frames of `drive_dir` that have image_02, image_03 and a velodyne .bin, sorted by name.
-std::vector<Frame> listFrames(const std::string& drive_dir);
+/// Frames with an image_02 but without image_03 or the .bin are left out; when `incomplete` is
+/// given, each gets a line there naming the frame and the missing file (sorted).
+std::vector<Frame> listFrames(const std::string& drive_dir,
+                              std::vector<std::string>* incomplete = nullptr);
 
 /// Images and sweep of one frame, checked: both images readable, BGR8, of the calibration's size.
 struct FrameData {
   cv::Mat left, right;  ///< BGR CV_8UC3 rectified image_02 / image_03
   LidarCloud cloud;     ///< the sweep, rings recovered by sweep order (0..63 on the HDL-64E)
+  /// How the rings were recovered: sweep order when plausible (every KITTI .bin), else elevation
+  /// (a shuffled sweep); `rings.plausible` false when neither looks like a scan pattern.
+  RingRecovery rings;
 };
-/// Reads a frame. Throws std::runtime_error naming the file when an image is unreadable, the two
-/// images differ in size, or their size differs from `camera`'s (when camera.width > 0).
+/// Reads a frame. 8-bit images are used as they are; 16-bit PNGs are scaled to 8 bits (value *
+/// 255 / 65535), grey or BGRA to BGR. Throws std::runtime_error naming the file when an image is
+/// unreadable or of another depth, the two images differ in size, or their size differs from
+/// `camera`'s (when camera.width > 0).
 FrameData loadFrame(const Frame& frame, const StereoCamera& camera);
 
 /// The folder holding a drive's calibration files: the parent of `drive_dir`

@@ -3,12 +3,16 @@
 // velodyne_pointcloud stamps a sweep at its last packet, so the sweep that covers an image is
 // usually stamped after it and arrives after it. An image set therefore waits (pending) until a
 // sweep stamped at or after the image has arrived -- from then on no later sweep can be nearer --
-// or until it has waited `max_wait` (wall time), and then takes the sweep nearest in time, looking
-// both ways, if that is within `max_time_offset`; otherwise it is given up ("unmatched").
+// or until ROS time has moved `max_wait` past its arrival, and then takes the sweep nearest in
+// time, looking both ways, if that is within `max_time_offset`; otherwise it is given up
+// ("unmatched").
+//
+// Every "now" is ROS time (ros::Time::now(): simulated time under `rosbag play --clock` with
+// /use_sim_time), never wall time: a bag played at -r 0.05 or paused pairs exactly as at real
+// time, because the wait scales with the playback.
 #pragma once
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <deque>
@@ -22,11 +26,9 @@ namespace lidar_stereo_fusion {
 template <class Images, class Sweep>
 class FrameMatcher {
  public:
-  using Clock = std::chrono::steady_clock;
-
   struct Params {
     double max_time_offset = 0.1;        ///< [s] largest |sweep stamp - image stamp| accepted
-    double max_wait = 0.3;               ///< [s] wall time an image set waits for a later sweep
+    double max_wait = 0.3;               ///< [s] ROS time an image set waits for a later sweep
     std::size_t sweep_buffer_size = 10;  ///< recent sweeps kept
     std::size_t max_pending = 4;  ///< image sets waiting at most; the oldest is decided first
     /// [s] a stamp this much older than the last one is a restart of time (a bag played with
@@ -45,6 +47,9 @@ class FrameMatcher {
   struct Events {
     std::vector<Match> ready;          ///< matched sets, oldest first
     std::vector<ros::Time> unmatched;  ///< image stamps given up: no sweep within max_time_offset
+    /// Per entry of `unmatched`: true when it was decided by waiting (max_wait or max_pending)
+    /// with no sweep at or after it yet, false when a later sweep had come and none was near.
+    std::vector<bool> unmatched_waited;
     bool out_of_order = false;  ///< the message passed in was not newer than the last one (dropped)
     bool restarted = false;     ///< time restarted (see Params::restart_step): buffers were cleared
     std::size_t discarded = 0;  ///< image sets still waiting that the restart threw away
@@ -54,8 +59,8 @@ class FrameMatcher {
   void setParams(const Params& params) { params_ = params; }
   const Params& params() const { return params_; }
 
-  /// Adds a synchronised image set stamped `stamp`.
-  Events addImages(const ros::Time& stamp, Images images, Clock::time_point now) {
+  /// Adds a synchronised image set stamped `stamp`, arriving at ROS time `now`.
+  Events addImages(const ros::Time& stamp, Images images, const ros::Time& now) {
     Events events;
     if (have_image_ && stamp <= last_image_stamp_) {
       if ((last_image_stamp_ - stamp).toSec() <= params_.restart_step) {
@@ -72,8 +77,8 @@ class FrameMatcher {
     return events;
   }
 
-  /// Adds a sweep stamped `stamp`.
-  Events addSweep(const ros::Time& stamp, Sweep sweep, Clock::time_point now) {
+  /// Adds a sweep stamped `stamp`, arriving at ROS time `now`.
+  Events addSweep(const ros::Time& stamp, Sweep sweep, const ros::Time& now) {
     Events events;
     if (!sweeps_.empty() && stamp <= sweeps_.back().first) {
       if ((sweeps_.back().first - stamp).toSec() <= params_.restart_step) {
@@ -90,8 +95,8 @@ class FrameMatcher {
     return events;
   }
 
-  /// Decides sets that have waited long enough; call periodically.
-  Events poll(Clock::time_point now) {
+  /// Decides sets that have waited long enough (ROS time `now`); call periodically.
+  Events poll(const ros::Time& now) {
     Events events;
     resolve(events, now);
     return events;
@@ -113,15 +118,15 @@ class FrameMatcher {
   struct Pending {
     ros::Time stamp;
     Images images;
-    Clock::time_point arrival;
+    ros::Time arrival;  ///< ROS time of arrival
   };
 
-  void resolve(Events& events, Clock::time_point now) {
-    const auto max_wait = std::chrono::duration<double>(params_.max_wait);
+  void resolve(Events& events, const ros::Time& now) {
     while (!pending_.empty()) {
       Pending& p = pending_.front();
       const bool later_sweep_seen = !sweeps_.empty() && sweeps_.back().first >= p.stamp;
-      const bool waited_enough = now - p.arrival >= max_wait;
+      // ROS time that went back (a bag loop) is not waiting: the caller clears the buffers then.
+      const bool waited_enough = now >= p.arrival && (now - p.arrival).toSec() >= params_.max_wait;
       const bool too_many = pending_.size() > std::max<std::size_t>(params_.max_pending, 1);
       if (!later_sweep_seen && !waited_enough && !too_many) break;  // later ones wait too
       const auto best = nearestSweep(p.stamp);
@@ -129,6 +134,7 @@ class FrameMatcher {
         events.ready.push_back({std::move(p.images), best->second, p.stamp, best->first});
       } else {
         events.unmatched.push_back(p.stamp);
+        events.unmatched_waited.push_back(!later_sweep_seen);
       }
       pending_.pop_front();
     }

@@ -1,0 +1,135 @@
+// The input gate of the live node: subscriptions (made and dropped by the output publisher, which
+// knows when anyone listens), the checks of every message where it enters, ~max_rate, and the
+// pairing of image sets with sweeps in ROS time (FrameMatcher). It hands the newest matched set to
+// the worker and drops (and counts) older ones: never a backlog.
+//
+// One lock (mutex_): the matcher, the hand-over slot, the clock and rate state. Subscribing and
+// unsubscribing happen without it (a subscription's shutdown waits for its running callbacks,
+// which take it) and are serialised by the caller.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <image_transport/image_transport.h>
+#include <image_transport/subscriber_filter.h>
+#include <message_filters/subscriber.h>
+#include <message_filters/sync_policies/approximate_time.h>
+#include <message_filters/sync_policies/exact_time.h>
+#include <message_filters/synchronizer.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <boost/optional.hpp>
+
+#include "lidar_stereo_fusion/ros/frame_matcher.h"
+#include "lidar_stereo_fusion/ros/node_support.h"
+
+namespace lidar_stereo_fusion {
+
+/// A synchronised stereo pair with its camera_infos, as it arrived.
+struct ImageSet {
+  sensor_msgs::ImageConstPtr left, right;
+  sensor_msgs::CameraInfoConstPtr left_info, right_info;
+  ros::Time arrival_ros;                               ///< ROS time when the set was complete
+  std::chrono::steady_clock::time_point arrival_wall;  ///< the same in wall time
+  uint32_t clock_epoch = 0;                            ///< InputGate::clockEpoch() at arrival
+};
+using InputMatcher = FrameMatcher<ImageSet, sensor_msgs::PointCloud2ConstPtr>;
+using InputMatch = InputMatcher::Match;
+
+/// Why a message was refused: the input topic (relative), a fixed word for the kind of problem
+/// (the throttle key) and the problem itself.
+struct Rejection {
+  std::string topic, kind, problem;
+};
+
+/// Checks of an image set that need no state: encodings, sizes, camera_infos against the images,
+/// a usable (and plausible) calibration, a frame_id. Pure; none when the set is usable.
+boost::optional<Rejection> checkImageSet(const ImageSet& set);
+/// Checks of a sweep: layout (conversions::checkCloudLayout), not empty, a frame_id.
+boost::optional<Rejection> checkCloud(const sensor_msgs::PointCloud2& cloud);
+
+/// ~max_rate: accepts a stamp when it is at least 0.9 / max_rate after the last accepted one (or
+/// before it: time went back, the matcher decides). max_rate 0 accepts everything. Not locked.
+class RateLimiter {
+ public:
+  explicit RateLimiter(double max_rate) : max_rate_(max_rate) {}
+  bool accept(const ros::Time& stamp);
+
+ private:
+  double max_rate_;
+  ros::Time last_;
+};
+
+class InputGate {
+ public:
+  InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, const NodeParams& params,
+            Counters& counters, ThrottledLog& log);
+  ~InputGate();
+  InputGate(const InputGate&) = delete;
+  InputGate& operator=(const InputGate&) = delete;
+
+  /// Subscribe to / drop the inputs. Not thread-safe against each other: the caller serialises.
+  /// Dropping forgets (and counts) every set still waiting.
+  void subscribe();
+  void unsubscribe();
+  bool subscribed() const { return subscribed_; }
+
+  /// The newest matched set, waiting up to `timeout` for one; first decides the sets that waited
+  /// ~max_sweep_wait of ROS time. None on timeout or after stop().
+  boost::optional<InputMatch> next(std::chrono::milliseconds timeout);
+  void stop();
+  bool stopped() const { return stopped_; }
+  /// Incremented whenever ROS time or the stamps restart (a bag loop): a set that arrived in an
+  /// earlier epoch cannot measure its latency in ROS time.
+  uint32_t clockEpoch() const { return clock_epoch_; }
+
+ private:
+  using Image = sensor_msgs::Image;
+  using Info = sensor_msgs::CameraInfo;
+  using ExactPolicy = message_filters::sync_policies::ExactTime<Image, Info, Image, Info>;
+  using ApproxPolicy = message_filters::sync_policies::ApproximateTime<Image, Info, Image, Info>;
+
+  void imageCb(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::CameraInfoConstPtr& li,
+               const sensor_msgs::ImageConstPtr& right, const sensor_msgs::CameraInfoConstPtr& ri);
+  void syncDropCb(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::CameraInfoConstPtr& li,
+                  const sensor_msgs::ImageConstPtr& right,
+                  const sensor_msgs::CameraInfoConstPtr& ri);
+  void cloudCb(const sensor_msgs::PointCloud2ConstPtr& cloud);
+  void reject(const Rejection& r, const ros::Time& stamp, const char* what_skipped);
+  // With mutex_ held:
+  void handleEvents(InputMatcher::Events& events, const std::string& topic, const ros::Time& stamp);
+  void detectClockJump();
+  std::string topicName(const std::string& relative) const { return nh_.resolveName(relative); }
+
+  ros::NodeHandle nh_, pnh_;
+  NodeParams params_;
+  Counters& counters_;
+  ThrottledLog& log_;
+
+  std::shared_ptr<image_transport::ImageTransport> it_;
+  image_transport::SubscriberFilter sub_left_image_, sub_right_image_;
+  message_filters::Subscriber<Info> sub_left_info_, sub_right_info_;
+  std::shared_ptr<message_filters::Synchronizer<ExactPolicy>> exact_sync_;
+  std::shared_ptr<message_filters::Synchronizer<ApproxPolicy>> approx_sync_;
+  ros::Subscriber sub_cloud_;
+  std::atomic<bool> subscribed_{false};
+
+  std::mutex mutex_;  ///< the one lock
+  std::condition_variable ready_cv_;
+  InputMatcher matcher_;
+  boost::optional<InputMatch> next_;
+  RateLimiter rate_;
+  ros::Time last_clock_;
+  bool stop_ = false;
+  std::atomic<bool> stopped_{false};
+  std::atomic<uint32_t> clock_epoch_{0};
+};
+
+}  // namespace lidar_stereo_fusion

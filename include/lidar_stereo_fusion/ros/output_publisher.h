@@ -1,0 +1,103 @@
+// The output publisher of the live node: advertises the outputs, subscribes the input gate while
+// any output has a subscriber (lazy subscription), turns a core result into messages, builds
+// FusionStats once from the core's FrameStats and a snapshot of the counters, and reports
+// diagnostics (output rate, stamps, processing time).
+//
+// Outputs (relative to the node handle): disparity (stereo_msgs/DisparityImage), depth +
+// depth/camera_info (32FC1 [m], NaN = none), points2 (x, y, z, rgb), lidar_disparity (the
+// up-sampled prior, 32FC1 [px], 0 = empty), disparity_image (32FC1 [px], 0 = none, for RViz),
+// confidence (32FC1 in [0, 1], the prior's confidence, 0 = no prior; all 0 for methods without
+// LiDAR), stats (lidar_stereo_fusion/FusionStats), plus /diagnostics. Every output is in the left
+// optical frame and stamped with the left image stamp.
+//
+// One lock (mutex_): the subscription state (serialising the gate's subscribe / unsubscribe) and
+// the windows of recent processing times.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <string>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <image_transport/image_transport.h>
+#include <ros/ros.h>
+#include <opencv2/core.hpp>
+
+#include "lidar_stereo_fusion/FusionStats.h"
+#include "lidar_stereo_fusion/core/lidar_projection.h"
+#include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/ros/input_gate.h"
+#include "lidar_stereo_fusion/ros/node_support.h"
+
+namespace lidar_stereo_fusion {
+
+/// What the worker knows of a frame beyond the core's result.
+struct FrameReport {
+  std::string method;
+  double conversion_ms = 0;  ///< ROS conversion in (the output conversion is added here)
+  int cloud_points = 0;      ///< finite points of the sweep
+  RingRecovery rings;
+};
+
+/// Latency [ms] from the image stamp to `publish_time` (ROS time). When ROS time restarted after
+/// the set arrived (`restarted`, or publish_time before the arrival: a bag loop), the latency at
+/// arrival (at least 0) plus the wall time since: a loop cannot make it negative.
+double latencyMs(const ros::Time& publish_time, const ros::Time& image_stamp,
+                 const ros::Time& arrival_ros, double wall_ms_since_arrival, bool restarted);
+
+/// FusionStats of one frame: the core's FrameStats, the frame report, the latency and the
+/// counters as they are now.
+FusionStatsPtr makeStatsMsg(const std_msgs::Header& header, const FrameStats& stats,
+                            const FrameReport& report, double total_conversion_ms,
+                            double latency_ms, double sweep_time_offset,
+                            const CounterSnapshot& counters);
+
+class OutputPublisher {
+ public:
+  OutputPublisher(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, const std::string& name,
+                  const NodeParams& params, Counters& counters, InputGate& gate);
+  ~OutputPublisher();
+  OutputPublisher(const OutputPublisher&) = delete;
+  OutputPublisher& operator=(const OutputPublisher&) = delete;
+
+  /// Advertises the outputs; from then on subscribers make the gate subscribe. Call last.
+  void advertise();
+  /// Unsubscribes the gate for good (shutdown).
+  void shutdown();
+  /// Publishes the outputs of one frame to the outputs that have subscribers.
+  void publish(const InputMatch& match, const StereoCamera& camera, const cv::Mat& left_image,
+               const FusionResult& result, const FusionParams& params, const FrameReport& report);
+
+ private:
+  void connectCb();
+  void diagnoseOutput(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void diagnoseProcessing(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  ros::NodeHandle nh_, pnh_;
+  NodeParams params_;
+  Counters& counters_;
+  InputGate& gate_;
+
+  std::shared_ptr<image_transport::ImageTransport> it_;
+  ros::Publisher pub_disparity_, pub_points_, pub_stats_;
+  // depth + depth/camera_info: not an image_transport CameraPublisher, which would put the info
+  // next to the image (camera_info), not under it.
+  image_transport::Publisher pub_depth_;
+  ros::Publisher pub_depth_info_;
+  image_transport::Publisher pub_lidar_disparity_, pub_disparity_image_, pub_confidence_;
+
+  diagnostic_updater::Updater updater_;
+  diagnostic_updater::FrequencyStatus output_frequency_;
+  diagnostic_updater::TimeStampStatus output_stamps_;
+  ros::Timer diag_timer_;
+
+  std::mutex mutex_;  ///< the one lock
+  bool shut_down_ = false;
+  std::deque<double> recent_total_ms_, recent_latency_ms_;
+  uint32_t diag_last_problems_ = 0;
+};
+
+}  // namespace lidar_stereo_fusion

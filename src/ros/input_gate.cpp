@@ -1,0 +1,290 @@
+#include "lidar_stereo_fusion/ros/input_gate.h"
+
+#include <sstream>
+#include <utility>
+
+#include <boost/bind/bind.hpp>
+
+#include "lidar_stereo_fusion/ros/conversions.h"
+
+namespace lidar_stereo_fusion {
+
+namespace {
+
+std::string sizeText(uint32_t width, uint32_t height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+}  // namespace
+
+boost::optional<Rejection> checkImageSet(const ImageSet& set) {
+  std::string problem = conversions::checkImage(*set.left);
+  if (!problem.empty()) return Rejection{kLeftImage, "image", problem};
+  problem = conversions::checkImage(*set.right);
+  if (!problem.empty()) return Rejection{kRightImage, "image", problem};
+  if (set.left->width != set.right->width || set.left->height != set.right->height) {
+    return Rejection{kRightImage, "size",
+                     "size " + sizeText(set.right->width, set.right->height) +
+                         " differs from the left image's " +
+                         sizeText(set.left->width, set.left->height)};
+  }
+  if (set.left_info->width != set.left->width || set.left_info->height != set.left->height) {
+    return Rejection{kLeftInfo, "size",
+                     "camera_info is " + sizeText(set.left_info->width, set.left_info->height) +
+                         " but the image is " + sizeText(set.left->width, set.left->height)};
+  }
+  if (set.right_info->width != set.right->width || set.right_info->height != set.right->height) {
+    return Rejection{kRightInfo, "size",
+                     "camera_info is " + sizeText(set.right_info->width, set.right_info->height) +
+                         " but the image is " + sizeText(set.right->width, set.right->height)};
+  }
+  try {
+    conversions::stereoCameraFromInfo(*set.left_info, *set.right_info);
+  } catch (const conversions::ConversionError& e) {
+    return Rejection{kRightInfo, "calibration", e.what()};
+  }
+  if (set.left->header.frame_id.empty()) {
+    return Rejection{kLeftImage, "frame_id",
+                     "empty frame_id (the left optical frame is needed for TF)"};
+  }
+  return boost::none;
+}
+
+boost::optional<Rejection> checkCloud(const sensor_msgs::PointCloud2& cloud) {
+  const std::string problem = conversions::checkCloudLayout(cloud);
+  if (!problem.empty()) return Rejection{kCloud, "layout", problem};
+  if (cloud.width == 0 || cloud.height == 0) {
+    return Rejection{kCloud, "empty", "empty cloud (0 points)"};
+  }
+  if (cloud.header.frame_id.empty()) return Rejection{kCloud, "frame_id", "empty frame_id"};
+  return boost::none;
+}
+
+bool RateLimiter::accept(const ros::Time& stamp) {
+  if (max_rate_ <= 0.0) return true;
+  // Less 10 % of the period for stamp jitter: 10 Hz input at max_rate 5 gives 5 Hz, not 3.3.
+  const double min_step = 0.9 / max_rate_;
+  if (!last_.isZero() && stamp >= last_ && (stamp - last_).toSec() < min_step) return false;
+  last_ = stamp;
+  return true;
+}
+
+InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+                     const NodeParams& params, Counters& counters, ThrottledLog& log)
+    : nh_(nh), pnh_(pnh), params_(params), counters_(counters), log_(log), rate_(params.max_rate) {
+  InputMatcher::Params mp;
+  mp.max_time_offset = params_.max_time_offset;
+  mp.max_wait = params_.max_sweep_wait;
+  mp.sweep_buffer_size = static_cast<std::size_t>(params_.sweep_buffer_size);
+  matcher_.setParams(mp);
+
+  // Synchroniser of the image set (connected once; the filters are (un)subscribed lazily).
+  using boost::placeholders::_1;
+  using boost::placeholders::_2;
+  using boost::placeholders::_3;
+  using boost::placeholders::_4;
+  it_ = std::make_shared<image_transport::ImageTransport>(nh_);
+  if (params_.approximate_sync) {
+    approx_sync_ = std::make_shared<message_filters::Synchronizer<ApproxPolicy>>(
+        ApproxPolicy(params_.queue_size), sub_left_image_, sub_left_info_, sub_right_image_,
+        sub_right_info_);
+    approx_sync_->setReset(true);  // clears its queues when simulated time jumps back
+    approx_sync_->registerCallback(boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4));
+  } else {
+    exact_sync_ = std::make_shared<message_filters::Synchronizer<ExactPolicy>>(
+        ExactPolicy(params_.queue_size), sub_left_image_, sub_left_info_, sub_right_image_,
+        sub_right_info_);
+    exact_sync_->setReset(true);
+    exact_sync_->registerCallback(boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4));
+    exact_sync_->registerDropCallback(boost::bind(&InputGate::syncDropCb, this, _1, _2, _3, _4));
+  }
+}
+
+InputGate::~InputGate() {
+  if (subscribed_) unsubscribe();
+  stop();
+}
+
+void InputGate::subscribe() {
+  const image_transport::TransportHints hints("raw", ros::TransportHints(), pnh_);
+  const uint32_t q = static_cast<uint32_t>(params_.queue_size);
+  sub_left_image_.subscribe(*it_, kLeftImage, q, hints);
+  sub_left_info_.subscribe(nh_, kLeftInfo, q);
+  sub_right_image_.subscribe(*it_, kRightImage, q, hints);
+  sub_right_info_.subscribe(nh_, kRightInfo, q);
+  sub_cloud_ = nh_.subscribe(kCloud, 2, &InputGate::cloudCb, this);
+  subscribed_ = true;
+  ROS_DEBUG_STREAM("[" << log_.name() << "] subscribed to the inputs");
+}
+
+void InputGate::unsubscribe() {
+  sub_left_image_.unsubscribe();
+  sub_left_info_.unsubscribe();
+  sub_right_image_.unsubscribe();
+  sub_right_info_.unsubscribe();
+  sub_cloud_.shutdown();
+  subscribed_ = false;
+  std::lock_guard<std::mutex> lock(mutex_);
+  // Sets in flight when the last subscriber leaves are dropped, and counted.
+  const std::size_t pending = matcher_.clear() + (next_ ? 1 : 0);
+  next_.reset();
+  counters_.dropped += static_cast<uint32_t>(pending);
+  ROS_DEBUG_STREAM("[" << log_.name() << "] no subscribers left: unsubscribed from the inputs");
+}
+
+void InputGate::stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  stopped_ = true;
+  ready_cv_.notify_all();
+}
+
+boost::optional<InputMatch> InputGate::next(std::chrono::milliseconds timeout) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  ready_cv_.wait_for(lock, timeout, [this] { return stop_ || static_cast<bool>(next_); });
+  if (stop_) return boost::none;
+  // Image sets that waited max_sweep_wait (ROS time) for a later sweep are decided here.
+  InputMatcher::Events events = matcher_.poll(ros::Time::now());
+  handleEvents(events, kLeftImage, ros::Time());
+  boost::optional<InputMatch> out = std::move(next_);
+  next_.reset();
+  return out;
+}
+
+void InputGate::reject(const Rejection& r, const ros::Time& stamp, const char* what_skipped) {
+  ++counters_.invalid;
+  log_.warn(r.topic, r.kind,
+            topicName(r.topic) + ": " + r.problem + " (stamp " + stampText(stamp) + "); " +
+                what_skipped + " skipped");
+}
+
+void InputGate::detectClockJump() {
+  // A bag played with --loop sends the clock back: forget the buffered stamps, or every later
+  // message would count as out of order.
+  const ros::Time now = ros::Time::now();
+  if (!last_clock_.isZero() && now + ros::Duration(0.5) < last_clock_) {
+    counters_.dropped += static_cast<uint32_t>(matcher_.clear());
+    ++clock_epoch_;
+    log_.log(ThrottledLog::Level::kInfo, "clock", "jump",
+             "ROS time jumped back from " + stampText(last_clock_) + " to " + stampText(now) +
+                 ": sweep and image buffers cleared (bag loop?)");
+  }
+  last_clock_ = now;
+}
+
+void InputGate::imageCb(const sensor_msgs::ImageConstPtr& left,
+                        const sensor_msgs::CameraInfoConstPtr& left_info,
+                        const sensor_msgs::ImageConstPtr& right,
+                        const sensor_msgs::CameraInfoConstPtr& right_info) {
+  const ros::Time stamp = left->header.stamp;
+  ROS_DEBUG_STREAM("[" << log_.name() << "] image set " << stampText(stamp));
+  {
+    // ~max_rate: dropped here, before any work; counted, never warned about (the user asked).
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!rate_.accept(stamp)) {
+      ++counters_.rate_limited;
+      return;
+    }
+  }
+  ImageSet set;
+  set.left = left;
+  set.right = right;
+  set.left_info = left_info;
+  set.right_info = right_info;
+  set.arrival_ros = ros::Time::now();
+  set.arrival_wall = std::chrono::steady_clock::now();
+  set.clock_epoch = clock_epoch_;
+  if (const auto rejection = checkImageSet(set)) return reject(*rejection, stamp, "image set");
+  std::lock_guard<std::mutex> lock(mutex_);
+  detectClockJump();
+  InputMatcher::Events events = matcher_.addImages(stamp, std::move(set), ros::Time::now());
+  handleEvents(events, kLeftImage, stamp);
+}
+
+void InputGate::syncDropCb(const sensor_msgs::ImageConstPtr& left,
+                           const sensor_msgs::CameraInfoConstPtr& left_info,
+                           const sensor_msgs::ImageConstPtr& right,
+                           const sensor_msgs::CameraInfoConstPtr& right_info) {
+  // ExactTime gave up on an incomplete set (a partner message never came with the same stamp).
+  ++counters_.unmatched;
+  std::string missing;
+  if (!left) missing += std::string(" ") + topicName(kLeftImage);
+  if (!left_info) missing += std::string(" ") + topicName(kLeftInfo);
+  if (!right) missing += std::string(" ") + topicName(kRightImage);
+  if (!right_info) missing += std::string(" ") + topicName(kRightInfo);
+  ros::Time stamp;
+  if (left)
+    stamp = left->header.stamp;
+  else if (right)
+    stamp = right->header.stamp;
+  else if (left_info)
+    stamp = left_info->header.stamp;
+  else if (right_info)
+    stamp = right_info->header.stamp;
+  log_.warn("image set", "incomplete",
+            "incomplete image set at stamp " + stampText(stamp) +
+                " dropped by the exact-time synchroniser; missing:" + missing +
+                " (different stamps? then set ~approximate_sync true)");
+}
+
+void InputGate::cloudCb(const sensor_msgs::PointCloud2ConstPtr& cloud) {
+  const ros::Time stamp = cloud->header.stamp;
+  ROS_DEBUG_STREAM("[" << log_.name() << "] sweep " << stampText(stamp) << " ("
+                       << static_cast<uint64_t>(cloud->width) * cloud->height << " points)");
+  if (const auto rejection = checkCloud(*cloud)) return reject(*rejection, stamp, "sweep");
+  std::lock_guard<std::mutex> lock(mutex_);
+  detectClockJump();
+  InputMatcher::Events events = matcher_.addSweep(stamp, cloud, ros::Time::now());
+  handleEvents(events, kCloud, stamp);
+}
+
+void InputGate::handleEvents(InputMatcher::Events& events, const std::string& topic,
+                             const ros::Time& stamp) {
+  if (events.restarted) {
+    counters_.dropped += static_cast<uint32_t>(events.discarded);
+    ++clock_epoch_;
+    std::ostringstream text;
+    text << topicName(topic) << ": stamp " << stampText(stamp) << " is more than "
+         << matcher_.params().restart_step
+         << " s older than the last one: time restarted (bag loop?), buffers cleared";
+    log_.log(ThrottledLog::Level::kInfo, topic, "restart", text.str());
+  }
+  if (events.out_of_order) {
+    ++counters_.out_of_order;
+    log_.warn(topic, "order",
+              topicName(topic) + ": stamp " + stampText(stamp) +
+                  " is not newer than one already received (out of order or duplicate); message "
+                  "dropped");
+  }
+  for (std::size_t i = 0; i < events.unmatched.size(); ++i) {
+    ++counters_.unmatched;
+    const std::string at = stampText(events.unmatched[i]);
+    if (events.unmatched_waited[i]) {  // no sweep at or after the set came in time
+      log_.warn(kCloud, "late",
+                "no sweep on " + topicName(kCloud) + " stamped at or after the image set at " + at +
+                    " arrived within ~max_sweep_wait = " + std::to_string(params_.max_sweep_wait) +
+                    " s (ROS time), and none before it within ~max_time_offset = " +
+                    std::to_string(params_.max_time_offset) +
+                    " s; image set skipped (is the LiDAR publishing? raise ~max_sweep_wait if its "
+                    "sweeps arrive late)");
+    } else {
+      log_.warn(kCloud, "unmatched",
+                "no sweep on " + topicName(kCloud) + " within ~max_time_offset = " +
+                    std::to_string(params_.max_time_offset) + " s of the image set at " + at +
+                    "; image set skipped (raise ~max_time_offset if the clocks differ)");
+    }
+  }
+  if (events.ready.empty()) return;
+  ROS_DEBUG_STREAM("[" << log_.name() << "] matched image set "
+                       << stampText(events.ready.back().image_stamp) << " with sweep "
+                       << stampText(events.ready.back().sweep_stamp));
+  // Only the newest set is worth processing: older ones (and a set still waiting for the worker)
+  // are dropped and counted, so a slow pipeline never builds a backlog.
+  counters_.dropped += static_cast<uint32_t>(events.ready.size() - 1 + (next_ ? 1 : 0));
+  next_ = std::move(events.ready.back());
+  ready_cv_.notify_one();
+}
+
+}  // namespace lidar_stereo_fusion

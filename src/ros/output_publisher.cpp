@@ -1,0 +1,257 @@
+#include "lidar_stereo_fusion/ros/output_publisher.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include <boost/make_shared.hpp>
+
+#include "lidar_stereo_fusion/core/depth.h"
+#include "lidar_stereo_fusion/ros/conversions.h"
+
+namespace lidar_stereo_fusion {
+
+namespace {
+
+constexpr std::size_t kDiagWindow = 30;  ///< frames averaged in the processing diagnostics
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+double latencyMs(const ros::Time& publish_time, const ros::Time& image_stamp,
+                 const ros::Time& arrival_ros, double wall_ms_since_arrival, bool restarted) {
+  if (!restarted && publish_time >= arrival_ros) return (publish_time - image_stamp).toSec() * 1e3;
+  // The set may itself have arrived after the restart (its stamp from the old loop, the arrival
+  // time from the new one): then the transport part is unknown, and 0 is the honest lower bound.
+  return std::max(0.0, (arrival_ros - image_stamp).toSec() * 1e3) + wall_ms_since_arrival;
+}
+
+FusionStatsPtr makeStatsMsg(const std_msgs::Header& header, const FrameStats& s,
+                            const FrameReport& report, double total_conversion_ms,
+                            double latency_ms, double sweep_time_offset, const CounterSnapshot& c) {
+  auto msg = boost::make_shared<FusionStats>();
+  msg->header = header;
+  msg->method = report.method;
+  msg->projection_ms = static_cast<float>(s.projection_ms);
+  msg->upsampling_ms = static_cast<float>(s.upsampling_ms);
+  msg->patchmatch_ms = static_cast<float>(s.patchmatch_ms);
+  msg->depth_ms = static_cast<float>(s.depth_ms);
+  msg->total_ms = static_cast<float>(s.total_ms);
+  msg->conversion_ms = static_cast<float>(total_conversion_ms);
+  msg->latency_ms = static_cast<float>(latency_ms);
+  msg->sweep_time_offset = static_cast<float>(sweep_time_offset);
+  msg->points_in_cloud = report.cloud_points;
+  msg->points_in_front = s.points_in_front;
+  msg->points_projected = s.points_projected;
+  msg->points_removed = s.points_removed;
+  msg->rings = report.rings.rings;
+  msg->rings_recovered = report.rings.source != RingSource::kField;
+  msg->ring_method = ringSourceName(report.rings.source);
+  msg->rings_plausible = report.rings.plausible;
+  msg->prior_coverage = static_cast<float>(s.prior_coverage);
+  msg->output_coverage = static_cast<float>(s.output_coverage);
+  msg->processed_frames = c.processed;
+  msg->dropped_frames = c.dropped;
+  msg->unmatched_frames = c.unmatched;
+  msg->tf_failures = c.tf_failures;
+  msg->invalid_inputs = c.invalid;
+  msg->out_of_order = c.out_of_order;
+  msg->processing_errors = c.errors;
+  msg->rate_limited = c.rate_limited;
+  return msg;
+}
+
+OutputPublisher::OutputPublisher(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
+                                 const std::string& name, const NodeParams& params,
+                                 Counters& counters, InputGate& gate)
+    : nh_(nh),
+      pnh_(pnh),
+      params_(params),
+      counters_(counters),
+      gate_(gate),
+      it_(std::make_shared<image_transport::ImageTransport>(nh)),
+      updater_(nh, pnh, name),
+      output_frequency_(diagnostic_updater::FrequencyStatusParam(&params_.diag_min_rate,
+                                                                 &params_.diag_max_rate, 0.1, 10)),
+      output_stamps_(diagnostic_updater::TimeStampStatusParam(-1.0, params_.diag_max_latency)) {
+  updater_.setHardwareID("none");
+  updater_.add("output", this, &OutputPublisher::diagnoseOutput);
+  updater_.add("processing", this, &OutputPublisher::diagnoseProcessing);
+  diag_timer_ =
+      nh_.createTimer(ros::Duration(0.5), [this](const ros::TimerEvent&) { updater_.update(); });
+}
+
+OutputPublisher::~OutputPublisher() { shutdown(); }
+
+void OutputPublisher::advertise() {
+  // Advertise under the lock so that connectCb sees every publisher (stereo_image_proc).
+  std::lock_guard<std::mutex> lock(mutex_);
+  const ros::SubscriberStatusCallback ros_cb = [this](const ros::SingleSubscriberPublisher&) {
+    connectCb();
+  };
+  const image_transport::SubscriberStatusCallback it_cb =
+      [this](const image_transport::SingleSubscriberPublisher&) { connectCb(); };
+  pub_disparity_ = nh_.advertise<stereo_msgs::DisparityImage>("disparity", 1, ros_cb, ros_cb);
+  pub_points_ = nh_.advertise<sensor_msgs::PointCloud2>("points2", 1, ros_cb, ros_cb);
+  pub_stats_ = nh_.advertise<FusionStats>("stats", 10, ros_cb, ros_cb);
+  pub_depth_ = it_->advertise("depth", 1, it_cb, it_cb);
+  pub_depth_info_ = nh_.advertise<sensor_msgs::CameraInfo>("depth/camera_info", 1, ros_cb, ros_cb);
+  pub_lidar_disparity_ = it_->advertise("lidar_disparity", 1, it_cb, it_cb);
+  pub_disparity_image_ = it_->advertise("disparity_image", 1, it_cb, it_cb);
+  pub_confidence_ = it_->advertise("confidence", 1, it_cb, it_cb);
+}
+
+void OutputPublisher::shutdown() {
+  diag_timer_.stop();
+  std::lock_guard<std::mutex> lock(mutex_);
+  shut_down_ = true;
+  if (gate_.subscribed()) gate_.unsubscribe();
+}
+
+void OutputPublisher::connectCb() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (shut_down_) return;
+  const uint32_t subscribers =
+      pub_disparity_.getNumSubscribers() + pub_points_.getNumSubscribers() +
+      pub_stats_.getNumSubscribers() + pub_depth_.getNumSubscribers() +
+      pub_depth_info_.getNumSubscribers() + pub_lidar_disparity_.getNumSubscribers() +
+      pub_disparity_image_.getNumSubscribers() + pub_confidence_.getNumSubscribers();
+  if (subscribers == 0 && gate_.subscribed()) {
+    gate_.unsubscribe();
+  } else if (subscribers > 0 && !gate_.subscribed()) {
+    gate_.subscribe();
+  }
+}
+
+void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camera,
+                              const cv::Mat& left_image, const FusionResult& result,
+                              const FusionParams& params, const FrameReport& report) {
+  const auto out_start = std::chrono::steady_clock::now();
+  const std_msgs::Header& header = match.images.left->header;
+  cv::Mat1f depth = result.depth;
+  if (depth.empty() && !result.disparity.empty())
+    depth = disparityToDepth(result.disparity, camera);
+
+  stereo_msgs::DisparityImagePtr disparity_msg;
+  sensor_msgs::ImagePtr depth_msg, prior_msg, disparity_image_msg, confidence_msg;
+  sensor_msgs::CameraInfoPtr depth_info;
+  sensor_msgs::PointCloud2Ptr points_msg;
+  if (pub_disparity_.getNumSubscribers() > 0) {
+    disparity_msg = conversions::disparityToMsg(result.disparity, header, camera,
+                                                params.patchmatch.min_disparity,
+                                                params.patchmatch.max_disparity);
+  }
+  if (pub_disparity_image_.getNumSubscribers() > 0) {
+    disparity_image_msg = conversions::floatImageToMsg(result.disparity, header);
+  }
+  if (pub_depth_.getNumSubscribers() > 0) {
+    depth_msg = conversions::depthToMsg(depth, header, params_.max_output_depth);
+  }
+  if (pub_depth_info_.getNumSubscribers() > 0) {
+    depth_info = boost::make_shared<sensor_msgs::CameraInfo>(*match.images.left_info);
+    depth_info->header = header;
+  }
+  if (pub_lidar_disparity_.getNumSubscribers() > 0) {
+    const cv::Mat1f prior =
+        result.prior.empty() ? cv::Mat1f::zeros(camera.height, camera.width) : result.prior;
+    prior_msg = conversions::floatImageToMsg(prior, header);
+  }
+  if (pub_confidence_.getNumSubscribers() > 0) {
+    // Empty for methods without LiDAR: all 0 (= no prior), so the topic always has a message.
+    const cv::Mat1f confidence = result.confidence.empty()
+                                     ? cv::Mat1f::zeros(camera.height, camera.width)
+                                     : result.confidence;
+    confidence_msg = conversions::floatImageToMsg(confidence, header);
+  }
+  if (pub_points_.getNumSubscribers() > 0) {
+    cv::Mat1f clipped = depth;
+    if (params_.max_output_depth > 0.0) {
+      clipped = depth.clone();
+      clipped.setTo(0.f, depth > params_.max_output_depth);
+    }
+    points_msg = conversions::coloredCloudToMsg(
+        makeColoredCloud(clipped, left_image, camera, params_.cloud_stride), header);
+  }
+  const double total_conversion_ms = report.conversion_ms + msSince(out_start);
+
+  // Publish everything as close together as possible.
+  const ros::Time publish_time = ros::Time::now();
+  if (disparity_msg) pub_disparity_.publish(disparity_msg);
+  if (depth_msg) pub_depth_.publish(depth_msg);
+  if (depth_info) pub_depth_info_.publish(depth_info);
+  if (disparity_image_msg) pub_disparity_image_.publish(disparity_image_msg);
+  if (prior_msg) pub_lidar_disparity_.publish(prior_msg);
+  if (confidence_msg) pub_confidence_.publish(confidence_msg);
+  if (points_msg) pub_points_.publish(points_msg);
+  ++counters_.processed;
+  const double latency_ms =
+      latencyMs(publish_time, match.image_stamp, match.images.arrival_ros,
+                msSince(match.images.arrival_wall), gate_.clockEpoch() != match.images.clock_epoch);
+  if (pub_stats_.getNumSubscribers() > 0) {
+    pub_stats_.publish(makeStatsMsg(header, result.stats, report, total_conversion_ms, latency_ms,
+                                    (match.sweep_stamp - match.image_stamp).toSec(),
+                                    counters_.snapshot()));
+  }
+
+  output_frequency_.tick();
+  output_stamps_.tick(match.image_stamp);
+  std::lock_guard<std::mutex> lock(mutex_);
+  recent_total_ms_.push_back(result.stats.total_ms + total_conversion_ms);
+  recent_latency_ms_.push_back(latency_ms);
+  while (recent_total_ms_.size() > kDiagWindow) recent_total_ms_.pop_front();
+  while (recent_latency_ms_.size() > kDiagWindow) recent_latency_ms_.pop_front();
+}
+
+void OutputPublisher::diagnoseOutput(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  if (!gate_.subscribed()) {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "idle: no subscriber on any output");
+    return;
+  }
+  output_frequency_.run(stat);
+  diagnostic_updater::DiagnosticStatusWrapper stamps;
+  output_stamps_.run(stamps);
+  stat.mergeSummary(stamps.level, stamps.message);
+  for (const auto& kv : stamps.values) stat.add(kv.key, kv.value);
+}
+
+void OutputPublisher::diagnoseProcessing(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  double mean_ms = 0, max_ms = 0, mean_latency = 0;
+  std::size_t n = 0;
+  const CounterSnapshot c = counters_.snapshot();
+  uint32_t new_problems = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    n = recent_total_ms_.size();
+    if (n > 0) {
+      mean_ms = std::accumulate(recent_total_ms_.begin(), recent_total_ms_.end(), 0.0) / n;
+      max_ms = *std::max_element(recent_total_ms_.begin(), recent_total_ms_.end());
+      mean_latency = std::accumulate(recent_latency_ms_.begin(), recent_latency_ms_.end(), 0.0) / n;
+    }
+    new_problems = c.problems() - diag_last_problems_;
+    diag_last_problems_ = c.problems();
+  }
+  if (new_problems != 0) {
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                  "%u input sets skipped or dropped since the last report (see the counters)",
+                  new_problems);
+  } else {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "ok");
+  }
+  stat.add("processing time mean [ms]", mean_ms);
+  stat.add("processing time max [ms]", max_ms);
+  stat.add("latency mean [ms]", mean_latency);
+  stat.add("frames averaged", n);
+  stat.add("processed frames", c.processed);
+  stat.add("dropped frames", c.dropped);
+  stat.add("unmatched frames", c.unmatched);
+  stat.add("tf failures", c.tf_failures);
+  stat.add("invalid inputs", c.invalid);
+  stat.add("out of order", c.out_of_order);
+  stat.add("processing errors", c.errors);
+  stat.add("rate limited (max_rate)", c.rate_limited);
+}
+
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,59 @@
+#include "kitti_bag_util.h"
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+
+#include "data/data_guard.h"
+
+namespace fs = std::filesystem;
+
+namespace lidar_stereo_fusion {
+namespace test {
+
+std::pair<int, std::string> runCommand(const std::string& command) {
+  std::string output;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return {-1, "popen failed"};
+  std::array<char, 512> buffer{};
+  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+std::string scratchDir(const std::string& name) {
+  const fs::path dir = fs::path(LSF_BINARY_DIR) / name;
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+std::string makeSubsetDrive(const std::string& scratch, const std::vector<std::string>& frames) {
+  const fs::path src_date = dataPath(kKittiDate);
+  const fs::path src = src_date / kKittiDrive;
+  const fs::path date = fs::path(scratch) / "subset" / "2011_09_26";
+  const fs::path drive = date / kKittiDrive;
+  fs::remove_all(date);
+  for (const char* calib : {"calib_cam_to_cam.txt", "calib_velo_to_cam.txt"}) {
+    fs::create_directories(date);
+    fs::create_symlink(src_date / calib, date / calib);
+  }
+  for (const std::string sensor : {"image_02", "image_03", "velodyne_points"}) {
+    fs::create_directories(drive / sensor / "data");
+    for (const auto& entry : fs::directory_iterator(src / sensor)) {
+      if (entry.path().extension() == ".txt") {
+        fs::create_symlink(entry.path(), drive / sensor / entry.path().filename());
+      }
+    }
+    const std::string ext = sensor == "velodyne_points" ? ".bin" : ".png";
+    for (const std::string& frame : frames) {
+      fs::create_symlink(src / sensor / "data" / (frame + ext),
+                         drive / sensor / "data" / (frame + ext));
+    }
+  }
+  return drive.string();
+}
+
+}  // namespace test
+}  // namespace lidar_stereo_fusion
