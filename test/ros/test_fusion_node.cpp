@@ -39,6 +39,7 @@
 #include "data/data_guard.h"
 #include "fusion_test_harness.h"
 #include "lidar_stereo_fusion/FusionStats.h"
+#include "lidar_stereo_fusion/core/patchmatch.h"
 #include "synthetic_input.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -451,14 +452,15 @@ TEST_F(FusionNode, K_ParametersChangeLiveAndInvalidOnesAreRejected) {
         c.doubles.push_back(p);
       },
       &result));
-  EXPECT_DOUBLE_EQ(value(result, "patchmatch_alpha"), 0.1);
+  const double default_alpha = lidar_stereo_fusion::PatchMatchParams().alpha;
+  EXPECT_DOUBLE_EQ(value(result, "patchmatch_alpha"), default_alpha);
   EXPECT_TRUE(h().waitForLog(mark, {"patchmatch/alpha"})) << h().logsSince(mark);
   auto stats = goodSetStats();
   ASSERT_TRUE(stats);
   EXPECT_EQ(stats->method, "fused_bi");
   double alpha = 0;
   ros::param::get(h().fusionNode() + "/patchmatch/alpha", alpha);
-  EXPECT_DOUBLE_EQ(alpha, 0.1);
+  EXPECT_DOUBLE_EQ(alpha, default_alpha);
 
   // A valid change applies to the next frame.
   ASSERT_TRUE(set(

@@ -575,7 +575,8 @@ TEST(RosParams, ConfigRoundTripKeepsEveryField) {
   EXPECT_EQ(q.method, lsf::Method::kFusedBF);
   EXPECT_EQ(q.patchmatch.seed, 1234u);
   EXPECT_NE(lsf::ros_params::describeChanges(lsf::FusionParams(), p)
-                .find("patchmatch/window_radius: 5 -> 9"),
+                .find("patchmatch/window_radius: " +
+                      std::to_string(lsf::PatchMatchParams().window_radius) + " -> 9"),
             std::string::npos)
       << lsf::ros_params::describeChanges(lsf::FusionParams(), p);
 }
