@@ -18,6 +18,8 @@ echo "== fuzz: build ($BUILD)"
 CC=clang CXX=clang++ cmake -S "$ROOT/fuzz" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
 cmake --build "$BUILD" -j"$JOBS"
 
+# -seed=1: a run explores the same inputs as any other run of the same length (a finding can be
+# reproduced by re-running the script), instead of a new random walk each time.
 status=0
 for target in pointcloud2 image kitti_calib kitti_bin autoware_calib params_yaml pcd; do
   seeds="$SEEDS/$target"
@@ -29,7 +31,7 @@ for target in pointcloud2 image kitti_calib kitti_bin autoware_calib params_yaml
   corpus="$BUILD/corpus/$target"
   mkdir -p "$corpus" "$BUILD/artifacts"
   echo "== fuzz_$target: ${SECONDS_PER_TARGET} s from $(ls "$seeds" | wc -l) seeds"
-  if ! (cd "$BUILD" && "./fuzz_$target" -max_total_time="$SECONDS_PER_TARGET" -timeout=10 \
+  if ! (cd "$BUILD" && "./fuzz_$target" -max_total_time="$SECONDS_PER_TARGET" -timeout=10 -seed=1 \
         -rss_limit_mb=2048 -malloc_limit_mb=1024 -print_final_stats=1 \
         -artifact_prefix="$BUILD/artifacts/${target}-" "$corpus" "$seeds" > "$BUILD/$target.log" 2>&1); then
     echo "fuzz_$target FAILED (reproducer in $BUILD/artifacts/):" >&2

@@ -1,6 +1,8 @@
 // Autoware camera-LiDAR calibration files (OpenCV FileStorage YAML).
 #include "lidar_stereo_fusion/io/calibration_autoware.h"
 
+#include "lidar_stereo_fusion/io/text_file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -128,6 +130,7 @@ AutowareCalibration readAutowareCalibration(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) {
     throw std::runtime_error("Autoware calibration: missing file " + path);
   }
+  requireTextFile(readTextFile(path, "Autoware calibration"), path, "Autoware calibration");
   cv::FileStorage fs;
   try {
     fs.open(path, cv::FileStorage::READ);

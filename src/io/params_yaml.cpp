@@ -5,6 +5,8 @@
 // writing all walk those lists, so a field added there is supported everywhere.
 #include "lidar_stereo_fusion/io/params_yaml.h"
 
+#include "lidar_stereo_fusion/io/text_file.h"
+
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -215,29 +217,9 @@ std::string withYamlDirective(const std::string& text) {
   return "%YAML:1.0\n---\n" + text;
 }
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("params YAML: cannot open " + path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
-/// Throws when `text` has control bytes other than tab, CR and LF: OpenCV reads a buffer only up
-/// to its first NUL, so binary garbage would otherwise load as an empty file (the defaults).
-void requireText(const std::string& text, const std::string& path) {
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    if (c < 0x20 && c != '\t' && c != '\n' && c != '\r') {
-      throw std::runtime_error("params YAML " + path + ": not a text file (control byte " +
-                               std::to_string(c) + " at offset " + std::to_string(i) + ")");
-    }
-  }
-}
-
 cv::FileStorage openYaml(const std::string& path) {
-  const std::string raw = readText(path);
-  requireText(raw, path);
+  const std::string raw = readTextFile(path, "params YAML");
+  requireTextFile(raw, path, "params YAML");
   const std::string text = withYamlDirective(raw);
   cv::FileStorage fs;
   try {

@@ -146,5 +146,23 @@ TEST(AutowareCalibration, MissingKeysAndNonRigidExtrinsicsAreErrorsNamingTheKey)
   EXPECT_THROW(readAutowareCalibration("/nonexistent/calibration.yaml"), std::runtime_error);
 }
 
+// Found by fuzzing: OpenCV's YAML parser never returned on this binary file (control bytes, then a
+// bracket sequence). Files with control bytes are refused before OpenCV sees them.
+TEST(AutowareCalibration, BinaryFilesAreRefusedBeforeOpenCvParsesThem) {
+  const std::string hang = std::string("%YAML:1.0\n---ta: [ 0, 0, 1, 2, -1, p, 0, 0, 0, -1, 0, 0, 0,  0,0, 9 ]\nC") +
+                           std::string("\x01\0\0\0", 4) + "ameraMael: plumb" +
+                           std::string(30, '\xa7') + "]" + std::string(5, '\xa7') +
+                           "45, 36400, 10, -1, -0.5 ]\n";
+  TempYaml file(hang);
+  try {
+    readAutowareCalibration(file.path());
+    ADD_FAILURE() << "a binary file was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a text file (control byte 1 at offset"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace lidar_stereo_fusion

@@ -1,0 +1,17 @@
+// Text files handed to OpenCV's FileStorage (parameters, calibrations). ROS-free.
+#pragma once
+
+#include <string>
+
+namespace lidar_stereo_fusion {
+
+/// The whole file at `path`; std::runtime_error "<what>: cannot open <path>" when unreadable.
+std::string readTextFile(const std::string& path, const std::string& what);
+
+/// Throws std::runtime_error "<what> <path>: not a text file (control byte B at offset N)" when
+/// `text` has control bytes other than tab, CR and LF. OpenCV reads a buffer only up to its first
+/// NUL (binary garbage would load as an empty file) and its YAML parser can loop forever on some
+/// binary input (found by fuzzing the Autoware reader), so such files never reach it.
+void requireTextFile(const std::string& text, const std::string& path, const std::string& what);
+
+}  // namespace lidar_stereo_fusion

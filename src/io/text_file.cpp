@@ -1,0 +1,28 @@
+// Text files handed to OpenCV's FileStorage (text_file.h).
+#include "lidar_stereo_fusion/io/text_file.h"
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace lidar_stereo_fusion {
+
+std::string readTextFile(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(what + ": cannot open " + path);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+void requireTextFile(const std::string& text, const std::string& path, const std::string& what) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 && c != '\t' && c != '\n' && c != '\r') {
+      throw std::runtime_error(what + " " + path + ": not a text file (control byte " +
+                               std::to_string(c) + " at offset " + std::to_string(i) + ")");
+    }
+  }
+}
+
+}  // namespace lidar_stereo_fusion
