@@ -11,7 +11,7 @@ PKGS=(
   libtf2-ros-dev libtf2-eigen-dev libtf2-sensor-msgs-dev
   libmessage-filters-dev librosbag-dev python3-rosbag
   librostest-dev python3-rostest
-  libstereo-msgs-dev ros-stereo-msgs libdiagnostic-updater-dev
+  libstereo-msgs-dev ros-stereo-msgs libdiagnostic-updater-dev python3-diagnostic-msgs
   python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev
   libgtest-dev libopencv-dev libeigen3-dev libyaml-cpp-dev
   python3-roslaunch ros-message-generation ros-message-runtime
