@@ -51,7 +51,9 @@ struct FrameStats {
 
 struct FusionResult {
   SparseDisparity sparse;   ///< stage 1 (left view)
-  cv::Mat1f prior;          ///< stage 2 (left view), 0 = empty
+  /// Stage 2 (left view) [px], 0 = empty. For the fused methods with confidence weighting, the
+  /// prior PatchMatch used: BI* (or BF*) plus the hole fill (fillPriorHoles) at low confidence.
+  cv::Mat1f prior;
   /// Confidence of the prior (left view), in [0, 1] (unitless): 1 on measured scan-line pixels,
   /// lower between scan lines that disagree and where Algorithm 1 removed points, 0 where the
   /// prior is empty. Empty for methods without LiDAR. See PriorConfidenceParams.
