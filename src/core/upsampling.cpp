@@ -6,14 +6,14 @@
 // (fresh full-size buffers cost page faults every frame).
 #include "lidar_stereo_fusion/core/upsampling.h"
 
-#include "column_index.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "column_index.h"
 
 namespace lidar_stereo_fusion {
 
