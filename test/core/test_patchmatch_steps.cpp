@@ -304,3 +304,17 @@ TEST(PatchMatchCoarseStart, PlanesScaleToFullSizeAndViewsReduceExactly) {
   EXPECT_TRUE(half.full_size_unbounded);
   EXPECT_EQ(pm::coarseParams(half).window_radius, 2);
 }
+
+TEST(PatchMatchCoarseStart, LeftRightCheckWithoutViewPropagationRuns) {
+  // The coarse levels have no left-right check: without view propagation they have no right
+  // view, and the full-size right view starts without a guide.
+  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(96, 48, 0.0, 0.0, 5.0, 4);
+  lsf::PatchMatchParams p;
+  p.view_propagation = false;
+  p.lr_check = true;
+  p.max_disparity = 16;
+  lsf::PatchMatchStereo pm(p);
+  const lsf::PatchMatchResult r = pm.compute({s.left}, {s.right});
+  EXPECT_EQ(r.disparity.size(), s.left.size());
+  EXPECT_NEAR(r.disparity(24, 48), 5.f, 0.5f);
+}

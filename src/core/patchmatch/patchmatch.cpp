@@ -110,7 +110,10 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     const PatchMatchResult coarse = coarse_->compute(downsampleView(left, p.coarse_scale),
                                                      downsampleView(right, p.coarse_scale));
     setGuide(upsamplePlanes(coarse.planes, p.coarse_scale, size), p, lv);
-    if (two_views) setGuide(upsamplePlanes(coarse.right_planes, p.coarse_scale, size), p, rv);
+    // The coarse level has no left-right check, so without view propagation it has no right view.
+    if (two_views && !coarse.right_planes.empty()) {
+      setGuide(upsamplePlanes(coarse.right_planes, p.coarse_scale, size), p, rv);
+    }
     iterations = p.fine_iterations;
   }
 
