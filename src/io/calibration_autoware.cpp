@@ -1,9 +1,8 @@
 // Autoware camera-LiDAR calibration files (OpenCV FileStorage YAML).
 #include "lidar_stereo_fusion/io/calibration_autoware.h"
 
-#include "lidar_stereo_fusion/io/text_file.h"
-
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -11,8 +10,44 @@
 
 #include <opencv2/core/eigen.hpp>
 
+#include "lidar_stereo_fusion/io/text_file.h"
+
 namespace lidar_stereo_fusion {
 namespace {
+
+/// Throws std::runtime_error naming the line when `text` is not laid out as the calibrator writes
+/// it: the %YAML directive, "---", "Key: value" lines at column 0 and indented continuation lines
+/// (matrix fields, wrapped data), blank lines and comments. OpenCV's YAML parser can loop forever
+/// on some malformed input (found by fuzzing: a bare "5, -1," line before "---at:"), so files of
+/// another shape never reach it.
+void requireAutowareLayout(const std::string& text, const std::string& path) {
+  std::size_t start = 0;
+  for (int number = 1; start <= text.size(); ++number) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    start = end + 1;
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) {
+      line.pop_back();
+    }
+    if (line.empty() || line[0] == '#' || line[0] == ' ' || line[0] == '\t' || line == "---" ||
+        ((line == "%YAML:1.0" || line == "%YAML 1.0") && number == 1)) {
+      continue;
+    }
+    std::size_t key_end = 0;
+    while (key_end < line.size() &&
+           (std::isalnum(static_cast<unsigned char>(line[key_end])) || line[key_end] == '_')) {
+      ++key_end;
+    }
+    const bool key_value = key_end > 0 && !std::isdigit(static_cast<unsigned char>(line[0])) &&
+                           key_end < line.size() && line[key_end] == ':' &&
+                           (key_end + 1 == line.size() || line[key_end + 1] == ' ');
+    if (!key_value) {
+      throw std::runtime_error("Autoware calibration " + path + ": line " + std::to_string(number) +
+                               " is not 'Key: value' (" + line.substr(0, 40) + ")");
+    }
+  }
+}
 
 std::string where(const std::string& path, const std::string& key) {
   return "Autoware calibration " + path + ": key '" + key + "'";
@@ -130,7 +165,9 @@ AutowareCalibration readAutowareCalibration(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) {
     throw std::runtime_error("Autoware calibration: missing file " + path);
   }
-  requireTextFile(readTextFile(path, "Autoware calibration"), path, "Autoware calibration");
+  const std::string text = readTextFile(path, "Autoware calibration");
+  requireTextFile(text, path, "Autoware calibration");
+  requireAutowareLayout(text, path);
   cv::FileStorage fs;
   try {
     fs.open(path, cv::FileStorage::READ);

@@ -149,10 +149,10 @@ TEST(AutowareCalibration, MissingKeysAndNonRigidExtrinsicsAreErrorsNamingTheKey)
 // Found by fuzzing: OpenCV's YAML parser never returned on this binary file (control bytes, then a
 // bracket sequence). Files with control bytes are refused before OpenCV sees them.
 TEST(AutowareCalibration, BinaryFilesAreRefusedBeforeOpenCvParsesThem) {
-  const std::string hang = std::string("%YAML:1.0\n---ta: [ 0, 0, 1, 2, -1, p, 0, 0, 0, -1, 0, 0, 0,  0,0, 9 ]\nC") +
-                           std::string("\x01\0\0\0", 4) + "ameraMael: plumb" +
-                           std::string(30, '\xa7') + "]" + std::string(5, '\xa7') +
-                           "45, 36400, 10, -1, -0.5 ]\n";
+  const std::string hang =
+      std::string("%YAML:1.0\n---ta: [ 0, 0, 1, 2, -1, p, 0, 0, 0, -1, 0, 0, 0,  0,0, 9 ]\nC") +
+      std::string("\x01\0\0\0", 4) + "ameraMael: plumb" + std::string(30, '\xa7') + "]" +
+      std::string(5, '\xa7') + "45, 36400, 10, -1, -0.5 ]\n";
   TempYaml file(hang);
   try {
     readAutowareCalibration(file.path());
@@ -160,6 +160,27 @@ TEST(AutowareCalibration, BinaryFilesAreRefusedBeforeOpenCvParsesThem) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("not a text file (control byte 1 at offset"),
               std::string::npos)
+        << e.what();
+  }
+}
+
+// Found by fuzzing too: a text file on which OpenCV's YAML parser never returned (a bare "5, -1,"
+// line before "---at:"). Lines the calibrator never writes are refused, naming the line.
+TEST(AutowareCalibration, MalformedLayoutIsRefusedNamingTheLine) {
+  TempYaml hang("%YAML:1.0s: 4\n   cols: 4\n5, -1,\n---at: !!opencv-matrix\n   rows: 4\n");
+  try {
+    readAutowareCalibration(hang.path());
+    ADD_FAILURE() << "a malformed file was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("line 1 is not 'Key: value'"), std::string::npos)
+        << e.what();
+  }
+  TempYaml bare("%YAML:1.0\n---\n5, -1,\nImageSize: [ 4, 4 ]\n");
+  try {
+    readAutowareCalibration(bare.path());
+    ADD_FAILURE() << "a bare sequence line was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("line 3 is not 'Key: value' (5, -1,)"), std::string::npos)
         << e.what();
   }
 }
