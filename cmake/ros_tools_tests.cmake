@@ -41,7 +41,7 @@ endif()
 
 # The calibration publishers on the real Autoware and KITTI calibrations.
 lsf_add_tools_rostest(test_calibration_publishers test/ros/calibration_publishers.test DATA_DIR_ARG
-  SOURCES test/ros/test_calibration_publishers.cpp
+  SOURCES test/ros/test_calibration_publishers.cpp test/ros/run_command.cpp
   DEPENDS autoware_calibration_publisher kitti_calibration_publisher)
 target_compile_definitions(test_calibration_publishers PRIVATE
   LSF_AUTOWARE_PUBLISHER="$<TARGET_FILE:autoware_calibration_publisher>"
@@ -50,7 +50,7 @@ target_compile_definitions(test_calibration_publishers PRIVATE
 # KITTI raw -> kitti_to_bag -> the fusion nodelet, compared with the offline kitti_runner.
 if(TARGET kitti_runner)
   lsf_add_tools_rostest(test_kitti_bag test/ros/kitti_bag.test
-    SOURCES test/ros/test_kitti_bag.cpp test/ros/kitti_bag_expected.cpp test/ros/kitti_bag_util.cpp
+    SOURCES test/ros/test_kitti_bag.cpp test/ros/kitti_bag_expected.cpp test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
     DEPENDS kitti_to_bag kitti_runner ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
   target_include_directories(test_kitti_bag SYSTEM PRIVATE
     ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})  # FusionStats.h
@@ -58,7 +58,7 @@ if(TARGET kitti_runner)
     LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>" LSF_KITTI_RUNNER="$<TARGET_FILE:kitti_runner>")
   lsf_add_tools_rostest(test_kitti_bag_rates test/ros/kitti_bag_rates.test
     SOURCES test/ros/test_kitti_bag_rates.cpp test/ros/kitti_bag_expected.cpp
-            test/ros/kitti_bag_util.cpp
+            test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
     DEPENDS kitti_to_bag ${PROJECT_NAME}_ros)
   target_compile_definitions(test_kitti_bag_rates PRIVATE
     LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")

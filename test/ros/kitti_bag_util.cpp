@@ -1,9 +1,5 @@
 #include "kitti_bag_util.h"
 
-#include <sys/wait.h>
-
-#include <array>
-#include <cstdio>
 #include <filesystem>
 
 #include "data/data_guard.h"
@@ -12,16 +8,6 @@ namespace fs = std::filesystem;
 
 namespace lidar_stereo_fusion {
 namespace test {
-
-std::pair<int, std::string> runCommand(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return {-1, "popen failed"};
-  std::array<char, 512> buffer{};
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
 
 std::string scratchDir(const std::string& name) {
   const fs::path dir = fs::path(LSF_BINARY_DIR) / name;

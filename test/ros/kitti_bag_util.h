@@ -6,15 +6,14 @@
 #include <utility>
 #include <vector>
 
+#include "run_command.h"  // runCommand
+
 namespace lidar_stereo_fusion {
 namespace test {
 
 /// KITTI raw date and drive of the sample data (../shared/data).
 constexpr const char* kKittiDate = "kitti_raw/2011_09_26";
 constexpr const char* kKittiDrive = "2011_09_26_drive_0009_sync";
-
-/// Exit status and output (stdout + stderr) of a shell command.
-std::pair<int, std::string> runCommand(const std::string& command);
 
 /// <build folder>/<name>, created.
 std::string scratchDir(const std::string& name);

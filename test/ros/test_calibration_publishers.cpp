@@ -7,10 +7,8 @@
 //    intrinsics they land where the devkit's P_rect_02 * R_rect_00 * [R | T] puts them.
 //  * Bad files: the publishers exit with status 1 and name the file.
 // Missing data fails under CI=true and skips otherwise.
-#include <sys/wait.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -31,6 +29,7 @@
 
 #include "data/data_guard.h"
 #include "lidar_stereo_fusion/io/kitti.h"
+#include "run_command.h"
 
 namespace fs = std::filesystem;
 
@@ -165,17 +164,6 @@ std::map<std::string, std::vector<double>> readKeyValues(const std::string& path
   return values;
 }
 
-/// Exit status and output (stdout + stderr) of a shell command.
-std::pair<int, std::string> run(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return {-1, "popen failed"};
-  std::array<char, 512> buffer{};
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) output += buffer.data();
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
-
 }  // namespace
 
 TEST(AutowareCalibrationPublisher, CalibDataReprojectsThroughTf_20191211) {
@@ -257,9 +245,9 @@ TEST(CalibrationPublishers, BadInputExitsWithStatusOneAndNamesTheFile) {
   fs::create_directories(scratch);
 
   const std::string missing = scratch + "/no_such_calibration.yaml";
-  auto [status, output] =
-      run("timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_missing _calibration_file:=" +
-          missing);
+  auto [status, output] = lidar_stereo_fusion::test::runCommand(
+      "timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_missing _calibration_file:=" +
+      missing);
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find(missing), std::string::npos) << output;
 
@@ -271,20 +259,20 @@ TEST(CalibrationPublishers, BadInputExitsWithStatusOneAndNamesTheFile) {
            "   data: [ 1000., 0., 960., 0., 1000., 600., 0., 0., 1. ]\n"
            "ImageSize: [ 1920, 1208 ]\n";
   }
-  std::tie(status, output) =
-      run("timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_key _calibration_file:=" +
-          no_extrinsic);
+  std::tie(status, output) = lidar_stereo_fusion::test::runCommand(
+      "timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_key _calibration_file:=" +
+      no_extrinsic);
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find("CameraExtrinsicMat"), std::string::npos) << output;
 
-  std::tie(status, output) =
-      run("timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_unset");
+  std::tie(status, output) = lidar_stereo_fusion::test::runCommand(
+      "timeout 30 " LSF_AUTOWARE_PUBLISHER " __name:=bad_autoware_unset");
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find("calibration_file"), std::string::npos) << output;
 
   const std::string no_calib_dir = scratch + "/no_such_kitti_date";
-  std::tie(status, output) =
-      run("timeout 30 " LSF_KITTI_PUBLISHER " __name:=bad_kitti _calib_dir:=" + no_calib_dir);
+  std::tie(status, output) = lidar_stereo_fusion::test::runCommand(
+      "timeout 30 " LSF_KITTI_PUBLISHER " __name:=bad_kitti _calib_dir:=" + no_calib_dir);
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find(no_calib_dir), std::string::npos) << output;
 }
