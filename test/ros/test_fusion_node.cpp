@@ -511,7 +511,10 @@ TEST_F(FusionNode, L_DiagnosticsReportRateAndProcessingTime) {
     }
     return false;
   };
-  for (int i = 0; i < 15 && !(has(": output") && has(": processing")); ++i) {
+  // The updater publishes once per diagnostic period (1 s), so keep frames coming for a wall-clock
+  // span rather than a frame count: on a fast machine 15 small frames take less than one period.
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(20.0);
+  while (ros::WallTime::now() < deadline && !(has(": output") && has(": processing"))) {
     const ros::Time stamp = h().nextStamp();
     h().publishSet(SetSpec(), stamp);
     h().waitForOutputs(stamp);
