@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -36,11 +37,16 @@ Options:
   --protocols <list>    comma-separated subset of middlebury,kitti (default both)
   --frames N            the first N KITTI frames (default all 11)
   --no-kitti-pms        skip pms and "lidar_bi else pms" on KITTI (~15 s per frame)
+  --params <yaml>       parameters of the "fused" row (and the base of lidar_*, pms), e.g. to
+                        compare a tuning against the defaults; default FusionParams()
+  --methods <list>      comma-separated subset of the rows: fused, paper, lidar_bi, lidar_bf, pms,
+                        "lidar_bi else pms", nearest (default all)
   --help                this text
 )";
 
 struct Options {
-  std::string data;
+  std::string data, params;
+  std::set<std::string> methods;
   bool middlebury = true, kitti = true, kitti_pms = true, help = false;
   int frames = 0;
 };
@@ -51,13 +57,19 @@ std::string defaultDataDir() {
 }
 
 Options parseOptions(int argc, char** argv) {
-  const lsf::CommandLine cl(argc, argv, {"--data", "--protocols", "--frames"},
+  const lsf::CommandLine cl(argc, argv, {"--data", "--protocols", "--frames", "--params", "--methods"},
                             {"--no-kitti-pms", "--help"});
   Options o;
   o.help = cl.has("--help");
   o.data = cl.value("--data", defaultDataDir());
   o.frames = cl.intValue("--frames", 0, 1, 1000);
   o.kitti_pms = !cl.has("--no-kitti-pms");
+  o.params = cl.value("--params", "");
+  if (cl.has("--methods")) {
+    std::stringstream list(cl.value("--methods"));
+    std::string item;
+    while (std::getline(list, item, ',')) o.methods.insert(item);
+  }
   if (cl.has("--protocols")) {
     o.middlebury = o.kitti = false;
     std::stringstream list(cl.value("--protocols"));
@@ -90,6 +102,8 @@ int run(const Options& o) {
   options.kitti_frames = o.frames;
   options.kitti_pms = o.kitti_pms;
   options.progress = &std::cerr;
+  options.methods = o.methods;
+  if (!o.params.empty()) lsf::loadParamsYaml(o.params, options.fused);
   const std::string paper = std::string(LSF_SOURCE_DIR) + "/config/paper.yaml";
   if (std::filesystem::is_regular_file(paper)) {
     lsf::FusionParams params;

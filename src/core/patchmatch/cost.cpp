@@ -9,6 +9,15 @@
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
+namespace {
+
+/// The lanes' sum in the order of cost_kernel.h (the AVX2 kernel's).
+float laneSum(const float* l) {
+  return ((l[0] + l[4]) + (l[2] + l[6])) + ((l[1] + l[5]) + (l[3] + l[7]));
+}
+
+}  // namespace
+
 void WindowCache::reserve(size_t n) {
   for (auto* v : {&xs, &ys, &w_img, &w_lidar, &c0, &c1, &c2, &g0, &g1, &priors}) v->assign(n, 0.f);
   row_offset.assign(n, 0);
@@ -60,7 +69,6 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
                             x_max,
                             x_max - 1e-3f,
                             self_.match_sign,
-                            static_cast<int>(offsets_.size()),
                             wa_,
                             use_grad_ ? wb_ : 0.f,
                             lcol_,
@@ -144,8 +152,7 @@ float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, floa
 
 template <bool kGrad>
 float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const {
-  float sum = cache.constant;
-  if (sum >= bound) return sum;
+  if (cache.constant >= bound) return cache.constant;
   const float x_max = static_cast<float>(self_.width - 1);
   const float x_clamp = x_max - 1e-3f;  // keeps i0 + 1 inside the row
   const float* other = other_.color.ptr<float>(0);
@@ -163,12 +170,13 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
   const float* g1 = cache.g1.data();
   const float* pr = cache.priors.data();
   const int* ro = cache.row_offset.data();
-  // Early exit checked once per window row's worth of samples: most refinement candidates are
-  // worse than the current plane, and the partial sum often exceeds it after a row or two.
-  const int chunk = static_cast<int>(offsets_.size());
-  for (int start = 0; start < cache.count; start += chunk) {
-    const int end = std::min(cache.count, start + chunk);
-    float part = 0.f;
+  // Terms are summed in kSimdBlock lanes (sample k into lane k % 8), the lanes reduced by
+  // laneSum(), and the bound checked after every block of 8 samples: the AVX2 kernel's order, so
+  // both return the same float. Most refinement candidates are worse than the current plane and
+  // exceed it after a few blocks.
+  float lanes[kSimdBlock] = {};
+  for (int start = 0; start < cache.count; start += kSimdBlock) {
+    const int end = std::min(cache.count, start + kSimdBlock);
     for (int k = start; k < end; ++k) {
       const float d = a * xs[k] + b * ys[k] + c;
       const float xm_raw = xs[k] + sign * d;
@@ -191,12 +199,12 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
       }
       rho_img = inside * rho_img + (1.f - inside) * outside_cost_;
       const float rho_lid = std::min(std::abs(pr[k] - d), ldisp_);
-      part += wi[k] * rho_img + wl[k] * rho_lid;
+      lanes[k - start] += wi[k] * rho_img + wl[k] * rho_lid;
     }
-    sum += part;
+    const float sum = cache.constant + laneSum(lanes);
     if (sum >= bound) return sum;
   }
-  return sum;
+  return cache.constant + laneSum(lanes);
 }
 
 }  // namespace patchmatch

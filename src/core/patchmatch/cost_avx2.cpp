@@ -7,9 +7,10 @@
 // computed as vectors; then, per sample, the two texels around x_q (B, G, R, 0, gx, gy, 0, 0) are
 // loaded as two 8-float vectors, interpolated and compared with the sample's own
 // texel; a tree of horizontal adds turns the 8 per-sample difference vectors into the colour L1
-// and gradient L1 of the 8 samples. Every float operation is the baseline's, in its order (no FMA
-// contraction, the sum accumulated sample by sample), so both paths give bit-identical costs and
-// PatchMatch results do not depend on the CPU.
+// and gradient L1 of the 8 samples; the 8 terms are added to 8 lane sums. Every float operation
+// is the baseline's, in its order (no FMA contraction, the lanes and their reduction as in
+// cost_kernel.h), so both paths give bit-identical costs and PatchMatch results do not depend on
+// the CPU.
 #include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
 
 #if defined(__AVX2__) && defined(__FMA__)
@@ -44,6 +45,13 @@ inline void channelSums(const __m256* dk, __m256& col, __m256& grad) {
   const __m256 s4567 = _mm256_hadd_ps(h45, h67);
   col = _mm256_permute2f128_ps(s0123, s4567, 0x20);
   grad = _mm256_permute2f128_ps(s0123, s4567, 0x31);
+}
+
+/// ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 + l7)) of the 8 lanes (cost_kernel.h's order).
+inline float laneSum(__m256 v) {
+  const __m128 s4 = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  const __m128 s2 = _mm_add_ps(s4, _mm_movehl_ps(s4, s4));
+  return _mm_cvtss_f32(_mm_add_ss(s2, _mm_shuffle_ps(s2, s2, 1)));
 }
 
 /// Pass 1 of buildWindowAvx2: positions, texels and priors of the samples inside the image, then
@@ -160,8 +168,7 @@ int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& 
 
 float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b, float c,
                     float bound) {
-  float sum = w.constant;
-  if (sum >= bound) return sum;
+  if (w.constant >= bound) return w.constant;
   const __m256 va = _mm256_set1_ps(a), vb = _mm256_set1_ps(b), vc = _mm256_set1_ps(c);
   const __m256 sign = _mm256_set1_ps(k.sign), zero = _mm256_setzero_ps();
   const __m256 x_max = _mm256_set1_ps(k.x_max), x_clamp = _mm256_set1_ps(k.x_clamp);
@@ -171,9 +178,7 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
   alignas(32) int offset[kSimdBlock];
   alignas(32) float frac[kSimdBlock];
-  alignas(32) float term[kSimdBlock];
-  float part = 0.f;
-  int left_in_chunk = k.chunk;
+  __m256 acc = zero;  // lane j sums the samples j, j + 8, j + 16, ... (the baseline's lanes)
   for (int s = 0; s < w.count; s += kSimdBlock) {
     // Each operation as the baseline code does it (no FMA; -ffp-contract=off for this file).
     const __m256 x = _mm256_loadu_ps(w.xs + s);
@@ -201,22 +206,14 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
     rho_img = _mm256_blendv_ps(outside, rho_img, inside);
     const __m256 lid = _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(w.priors + s), d));
     const __m256 rho_lid = _mm256_min_ps(lid, ldisp);
-    _mm256_store_ps(term, _mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(w.w_img + s), rho_img),
-                                        _mm256_mul_ps(_mm256_loadu_ps(w.w_lidar + s), rho_lid)));
-    // Summed in sample order, the bound checked after every `chunk` samples and after the last:
-    // the baseline's order, so both paths return the same float.
-    const int n = w.real_count - s < kSimdBlock ? w.real_count - s : kSimdBlock;
-    for (int j = 0; j < n; ++j) {
-      part += term[j];
-      if (--left_in_chunk == 0) {
-        sum += part;
-        if (sum >= bound) return sum;
-        part = 0.f;
-        left_in_chunk = k.chunk;
-      }
-    }
+    // Padding samples have zero weights: their term is exactly 0 and leaves the lanes unchanged.
+    acc = _mm256_add_ps(acc, _mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(w.w_img + s), rho_img),
+                                           _mm256_mul_ps(_mm256_loadu_ps(w.w_lidar + s), rho_lid)));
+    // The bound is checked after every block, as the baseline does: the same exit, the same float.
+    const float sum = w.constant + laneSum(acc);
+    if (sum >= bound) return sum;
   }
-  return left_in_chunk == k.chunk ? sum : sum + part;
+  return w.constant + laneSum(acc);
 }
 
 }  // namespace patchmatch

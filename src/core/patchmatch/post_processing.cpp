@@ -12,8 +12,53 @@
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
+namespace {
+
+/// The colour-weighted median of (d[i], w[i]), i < n: the smallest d whose cumulative weight in
+/// ascending order of d reaches `half` (half the total weight). A three-way quickselect, O(n) on
+/// average; d and w are reordered.
+float weightedMedian(float* d, float* w, int n, float half) {
+  int lo = 0, hi = n;  // the answer is among [lo, hi)
+  float pivot = d[0];
+  while (hi - lo > 1) {
+    const float a = d[lo], b = d[lo + (hi - lo) / 2], c = d[hi - 1];
+    pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));  // median of three
+    // [lo, lt) < pivot, [lt, gt) == pivot, [gt, hi) > pivot.
+    int lt = lo, i = lo, gt = hi;
+    float w_less = 0.f, w_equal = 0.f;
+    while (i < gt) {
+      if (d[i] < pivot) {
+        std::swap(d[i], d[lt]);
+        std::swap(w[i], w[lt]);
+        w_less += w[lt];
+        ++lt;
+        ++i;
+      } else if (d[i] > pivot) {
+        --gt;
+        std::swap(d[i], d[gt]);
+        std::swap(w[i], w[gt]);
+      } else {
+        w_equal += w[i];
+        ++i;
+      }
+    }
+    if (w_less >= half && lt > lo) {
+      hi = lt;
+    } else if (w_less + w_equal >= half || gt == hi) {
+      return pivot;
+    } else {
+      half -= w_less + w_equal;
+      lo = gt;
+    }
+  }
+  return hi - lo == 1 ? d[lo] : pivot;
+}
+
+}  // namespace
+
 cv::Mat1f disparityOf(const ViewState& v) {
   cv::Mat1f d(v.height, v.width);
+#pragma omp parallel for schedule(static)
   for (int y = 0; y < v.height; ++y) {
     for (int x = 0; x < v.width; ++x) {
       d(y, x) = v.planes[y * v.width + x].at(static_cast<float>(x), static_cast<float>(y));
@@ -25,6 +70,7 @@ cv::Mat1f disparityOf(const ViewState& v) {
 cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float max_diff,
                          const std::vector<uint8_t>& keep, bool unmatched_bad) {
   cv::Mat1b bad(left.size(), uchar(0));
+#pragma omp parallel for schedule(static)
   for (int y = 0; y < left.rows; ++y) {
     for (int x = 0; x < left.cols; ++x) {
       if (!keep.empty() && keep[y * left.cols + x]) continue;
@@ -43,6 +89,7 @@ cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float ma
 void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float fill_trust,
                cv::Mat1f& disparity, int threads) {
   if (!v.prior.empty()) {
+#pragma omp parallel for schedule(static) num_threads(threads)
     for (int y = 0; y < v.height; ++y) {
       for (int x = 0; x < v.width; ++x) {
         if (bad(y, x) && v.prior(y, x) > 0.f && v.trust(y, x) >= fill_trust) {
@@ -55,13 +102,21 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
   cv::Mat1f filled = disparity.clone();
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
+    // The nearest consistent pixel to the left of each pixel, found in one pass (-1: none).
+    std::vector<int> left_good(v.width);
+    int last = -1;
     for (int x = 0; x < v.width; ++x) {
-      if (!bad(y, x)) continue;
+      left_good[x] = last;
+      if (!bad(y, x)) last = x;
+    }
+    int xr = v.width;  // the nearest consistent pixel to the right (width: none)
+    for (int x = v.width - 1; x >= 0; --x) {
+      if (!bad(y, x)) {
+        xr = x;
+        continue;
+      }
       float best = std::numeric_limits<float>::max();
-      int xl = x - 1;
-      while (xl >= 0 && bad(y, xl)) --xl;
-      int xr = x + 1;
-      while (xr < v.width && bad(y, xr)) ++xr;
+      const int xl = left_good[x];
       const float fx = static_cast<float>(x), fy = static_cast<float>(y);
       if (xl >= 0) best = std::min(best, v.planes[y * v.width + xl].at(fx, fy));
       if (xr < v.width) best = std::min(best, v.planes[y * v.width + xr].at(fx, fy));
@@ -74,10 +129,11 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
   filled.copyTo(disparity);  // same size: no new allocation
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
-    std::vector<std::pair<float, float>> samples;
+    std::vector<float> ds, ws;
     for (int x = 0; x < v.width; ++x) {
       if (!bad(y, x)) continue;
-      samples.clear();
+      ds.clear();
+      ws.clear();
       const cv::Vec3f& c = v.color(y, x);
       float total = 0.f;
       // Every second row and column of the window: the median barely changes, the cost quarters.
@@ -91,20 +147,14 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
           const int l1 = static_cast<int>(std::abs(q[0] - c[0]) + std::abs(q[1] - c[1]) +
                                           std::abs(q[2] - c[2]));
           const float w = lut[std::min<int>(l1, static_cast<int>(lut.size()) - 1)];
-          samples.emplace_back(d, w);
+          ds.push_back(d);
+          ws.push_back(w);
           total += w;
         }
       }
-      if (samples.empty()) continue;
-      std::sort(samples.begin(), samples.end());
-      float acc = 0.f;
-      for (const auto& s : samples) {
-        acc += s.second;
-        if (acc >= 0.5f * total) {
-          disparity(y, x) = s.first;
-          break;
-        }
-      }
+      if (ds.empty()) continue;
+      disparity(y, x) =
+          weightedMedian(ds.data(), ws.data(), static_cast<int>(ds.size()), 0.5f * total);
     }
   }
 }

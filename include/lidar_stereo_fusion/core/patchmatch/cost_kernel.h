@@ -41,7 +41,6 @@ struct KernelConstants {
   float x_max;                ///< width - 1 [px]
   float x_clamp;              ///< largest x of the left interpolation node, < x_max
   float sign;                 ///< match of x at x + sign * d
-  int chunk;                  ///< samples between two checks of the bound (the baseline's)
   float alpha, beta, lambda_col, lambda_grad, lambda_disp, outside_cost;
 };
 
@@ -77,6 +76,10 @@ int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& 
 /// True when cost_avx2.cpp was compiled with AVX2 + FMA (x86 builds).
 extern const bool kAvx2KernelBuilt;
 
+/// Summation order of C, shared by both paths so that they return the same float: sample k's
+/// term is added to lane k % kSimdBlock; C = constant + ((l0 + l4) + (l2 + l6)) + ((l1 + l5) +
+/// (l3 + l7)); the bound is checked after every block of kSimdBlock samples (a partial sum only
+/// grows, so checking never changes which plane wins).
 /// C(p, xi) for the plane d = a x + b y + c over the window; stops once the partial sum is
 /// >= bound (returning it), else returns the full sum. Call only when the CPU has AVX2 + FMA.
 float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b, float c,
