@@ -103,6 +103,7 @@ PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
   base.gamma = 0.0;
   base.window_radius = 17;
   base.window_stride = 3;
+  base.window_dyadic = false;
   base.median_radius = 17;
   base.right_iterations = -1;
   base.init_from_prior = false;

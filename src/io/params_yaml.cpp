@@ -60,6 +60,7 @@ template <class P, class V>
 void visitPatchMatch(P& p, V& v) {
   v("window_radius", p.window_radius);
   v("window_stride", p.window_stride);
+  v("window_dyadic", p.window_dyadic);
   v("weight_delta", p.weight_delta);
   v("alpha", p.alpha);
   v("beta", p.beta);
@@ -89,6 +90,8 @@ void visitPatchMatch(P& p, V& v) {
   v("full_size_unbounded", p.full_size_unbounded);
   v("fine_iterations", p.fine_iterations);
   v("fine_refine_range", p.fine_refine_range);
+  v("fine_right_view", p.fine_right_view);
+  v("fine_subpixel", p.fine_subpixel);
   v("num_threads", p.num_threads);
   v("seed", p.seed);
 }

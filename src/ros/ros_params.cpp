@@ -45,6 +45,7 @@ void visitParams(FusionParams& p, Visitor&& v) {
   PatchMatchParams& m = p.patchmatch;
   v("patchmatch", "window_radius", m.window_radius);
   v("patchmatch", "window_stride", m.window_stride);
+  v("patchmatch", "window_dyadic", m.window_dyadic);
   v("patchmatch", "weight_delta", m.weight_delta);
   v("patchmatch", "alpha", m.alpha);
   v("patchmatch", "beta", m.beta);
@@ -74,6 +75,8 @@ void visitParams(FusionParams& p, Visitor&& v) {
   v("patchmatch", "full_size_unbounded", m.full_size_unbounded);
   v("patchmatch", "fine_iterations", m.fine_iterations);
   v("patchmatch", "fine_refine_range", m.fine_refine_range);
+  v("patchmatch", "fine_right_view", m.fine_right_view);
+  v("patchmatch", "fine_subpixel", m.fine_subpixel);
   v("patchmatch", "num_threads", m.num_threads);
   v("patchmatch", "seed", m.seed);
 }

@@ -62,6 +62,15 @@ void randomPrior(int w, int h, std::mt19937& rng, cv::Mat1f& prior, cv::Mat1f& c
 
 /// C(p, plane) of cost.h in double precision, straight from the equations. w is the
 /// implementation's: exp(-l / delta) with l the RGB L1 distance rounded down to 1/4 (its LUT).
+/// Whether the window uses offset o: a multiple of the stride, and with dyadic sampling 0 or the
+/// stride times a power of two.
+bool usedOffset(const lsf::PatchMatchParams& p, int o) {
+  const int m = std::abs(o);
+  if (m % p.window_stride != 0) return false;
+  const int k = m / p.window_stride;
+  return !p.window_dyadic || k == 0 || (k & (k - 1)) == 0;
+}
+
 double referenceCost(const lsf::PatchMatchParams& p, const pm::ViewState& self,
                      const pm::ViewState& other, int px, int py, const pm::Plane& plane) {
   const bool use_prior = p.gamma > 0 && !self.prior.empty();
@@ -71,7 +80,7 @@ double referenceCost(const lsf::PatchMatchParams& p, const pm::ViewState& self,
   for (int dy = -p.window_radius; dy <= p.window_radius; ++dy) {
     for (int dx = -p.window_radius; dx <= p.window_radius; ++dx) {
       const int x = px + dx, y = py + dy;
-      if (dy % p.window_stride || dx % p.window_stride) continue;
+      if (!usedOffset(p, dy) || !usedOffset(p, dx)) continue;
       if (x < 0 || y < 0 || x >= self.width || y >= self.height) continue;
       const cv::Vec3f c = self.color(y, x);
       double l1 = 0;
@@ -122,6 +131,7 @@ void compareKernels(const CostCase& cc, uint32_t seed) {
   const int w = 97, h = 41;
   lsf::PatchMatchParams p;
   p.confidence_weighting = cc.weighted;
+  p.window_dyadic = seed % 2 == 0;  // both window patterns
   if (!cc.with_grad) {
     p.alpha = 0.1;
     p.beta = 0.0;

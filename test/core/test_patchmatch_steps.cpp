@@ -196,6 +196,60 @@ TEST(PatchMatchSearch, RefinementFindsTheTruePlaneAndStaysInsideTheBounds) {
   EXPECT_NEAR(best.at(40.f, 15.f), 9.f, 0.25f);
 }
 
+TEST(PatchMatchCost, WindowOffsetsAreEveryStrideOrDyadic) {
+  EXPECT_EQ(pm::windowOffsets(8, 2, false), (std::vector<int>{-8, -6, -4, -2, 0, 2, 4, 6, 8}));
+  EXPECT_EQ(pm::windowOffsets(8, 2, true), (std::vector<int>{-8, -4, -2, 0, 2, 4, 8}));
+  EXPECT_EQ(pm::windowOffsets(4, 1, true), (std::vector<int>{-4, -2, -1, 0, 1, 2, 4}));
+  EXPECT_EQ(pm::windowOffsets(6, 2, true), (std::vector<int>{-4, -2, 0, 2, 4}));
+  EXPECT_EQ(pm::windowOffsets(5, 5, true), pm::windowOffsets(5, 5, false));  // {-5, 0, 5}
+}
+
+TEST(PatchMatchSearch, SubpixelStepMovesDToTheCostMinimum) {
+  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(80, 30, 0.0, 0.0, 9.0, 5);
+  lsf::PatchMatchParams p = params3x3();
+  p.window_radius = 3;
+  Views v = prepare({s.left}, {s.right}, p);
+  const pm::PlaneSearch search(p, v.left, v.right);
+  pm::WindowCache cache;
+  search.cost().buildWindow(40, 15, cache);
+  for (const float start : {8.96f, 9.05f}) {
+    pm::Plane best{0.f, 0.f, start};
+    float best_cost = search.cost().aggregate(cache, best, std::numeric_limits<float>::max());
+    const float start_cost = best_cost;
+    search.subpixelStep(40, 15, cache, best, best_cost);
+    EXPECT_LT(best_cost, start_cost) << start;
+    EXPECT_LT(std::abs(best.c - 9.f), 0.6f * std::abs(start - 9.f)) << start;
+    EXPECT_EQ(best.a, 0.f);  // the normal is kept
+    EXPECT_EQ(best.b, 0.f);
+  }
+}
+
+TEST(PatchMatchSearch, WithoutRefinementAPixelOnlyTakesItsNeighboursPlane) {
+  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(80, 30, 0.0, 0.0, 9.0, 5);
+  lsf::PatchMatchParams p = params3x3();
+  p.window_radius = 3;
+  Views v = prepare({s.left}, {s.right}, p);
+  pm::SearchOptions propagation_only;
+  propagation_only.refine = false;
+  for (const bool refine : {false, true}) {
+    const pm::PlaneSearch search(p, v.left, v.right,
+                                 refine ? pm::SearchOptions() : propagation_only);
+    const int idx = 15 * 80 + 40;
+    v.left.planes[idx] = pm::Plane{0.f, 0.f, 7.f};
+    v.left.cost[idx] = pm::kUnknownCost;
+    v.left.planes[idx - 1] = pm::Plane{0.f, 0.f, 9.f};  // the left neighbour has the true plane
+    v.left.planes[idx - 80] = pm::Plane{0.f, 0.f, 7.f};
+    pm::WindowCache cache;
+    search.processPixel(40, 15, true, 0, cache);
+    if (refine) {
+      EXPECT_NEAR(v.left.planes[idx].at(40.f, 15.f), 9.f, 0.1f);  // refined around it
+    } else {
+      EXPECT_EQ(v.left.planes[idx].c, 9.f);  // exactly the neighbour's plane
+      EXPECT_EQ(v.left.planes[idx].a, 0.f);
+    }
+  }
+}
+
 TEST(PatchMatchViewPropagation, AGoodLeftPlaneReachesItsMatchInTheRightView) {
   const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(80, 20, 0.0, 0.0, 6.0, 9);
   lsf::PatchMatchParams p = params3x3();

@@ -18,6 +18,22 @@ float laneSum(const float* l) {
 
 }  // namespace
 
+std::vector<int> windowOffsets(int radius, int stride, bool dyadic) {
+  std::vector<int> offsets;
+  if (!dyadic) {
+    for (int o = -radius; o <= radius; ++o) {
+      if (o % stride == 0) offsets.push_back(o);
+    }
+    return offsets;
+  }
+  std::vector<int> positive;
+  for (int o = stride; o <= radius; o *= 2) positive.push_back(o);
+  for (auto it = positive.rbegin(); it != positive.rend(); ++it) offsets.push_back(-*it);
+  offsets.push_back(0);
+  offsets.insert(offsets.end(), positive.begin(), positive.end());
+  return offsets;
+}
+
 void WindowCache::reserve(size_t n) {
   for (auto* v : {&xs, &ys, &w_img, &w_lidar, &c0, &c1, &c2, &g0, &g1, &priors}) v->assign(n, 0.f);
   row_offset.assign(n, 0);
@@ -28,9 +44,7 @@ void WindowCache::reserve(size_t n) {
 MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self,
                            const ViewState& other)
     : p_(params), self_(self), other_(other) {
-  for (int o = -params.window_radius; o <= params.window_radius; ++o) {
-    if (o % params.window_stride == 0) offsets_.push_back(o);
-  }
+  offsets_ = windowOffsets(params.window_radius, params.window_stride, params.window_dyadic);
   weight_lut_.resize(kLutSize);
   for (int i = 0; i < kLutSize; ++i) {
     weight_lut_[i] = std::exp(-(i / kLutScale) / static_cast<float>(params.weight_delta));

@@ -5,7 +5,9 @@
 //
 // Per iteration: left view sweep. In the last `right_iterations` iterations also: view
 // propagation of the left planes into the right view, right view sweep, view propagation back
-// into the left. Then the left-right check and filling.
+// into the left. Then the left-right check and filling. At the full-size level after a coarse
+// start, the right view sweeps by propagation alone (fine_right_view) and the left view ends each
+// pixel's refinement with a sub-pixel step (fine_subpixel).
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -34,6 +36,7 @@ std::vector<uint8_t> lockedToPrior(const patchmatch::ViewState& v) {
 
 cv::Mat3f planeMap(const patchmatch::ViewState& v) {
   cv::Mat3f map(v.height, v.width);
+#pragma omp parallel for schedule(static)
   for (int y = 0; y < v.height; ++y) {
     for (int x = 0; x < v.width; ++x) {
       const patchmatch::Plane& pl = v.planes[y * v.width + x];
@@ -103,7 +106,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   const bool two_views = p.view_propagation || p.lr_check;
 
   int iterations = p.iterations;
-  if (p.coarse_scale > 1 && std::min(size.width, size.height) >= 4 * p.coarse_scale) {
+  const bool guided = p.coarse_scale > 1 && std::min(size.width, size.height) >= 4 * p.coarse_scale;
+  if (guided) {
     // Coarse start: its planes, up-sampled, are where the full-size search begins.
     if (!coarse_) coarse_ = std::make_shared<PatchMatchStereo>(coarseParams(p));
     coarse_->setParams(coarseParams(p));
@@ -117,8 +121,14 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     iterations = p.fine_iterations;
   }
 
-  PlaneSearch left_search(p, lv, rv);
-  PlaneSearch right_search(p, rv, lv);
+  // The full-size level after a coarse start polishes the planes it was given: the left view
+  // with a sub-pixel step after refinement; the right view, which serves view propagation and
+  // the left-right check, by propagation alone unless fine_right_view.
+  SearchOptions left_options, right_options;
+  left_options.subpixel = guided && p.fine_subpixel;
+  right_options.refine = !guided || p.fine_right_view;
+  PlaneSearch left_search(p, lv, rv, left_options);
+  PlaneSearch right_search(p, rv, lv, right_options);
   initialise(left_search, lv, p, 0);
   if (two_views) initialise(right_search, rv, p, 1);
   // The right view sweeps in the last `right_iterations` iterations only. It serves view

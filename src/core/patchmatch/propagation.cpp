@@ -10,8 +10,9 @@
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
-PlaneSearch::PlaneSearch(const PatchMatchParams& params, ViewState& self, const ViewState& other)
-    : p_(params), self_(self), cost_(params, self, other) {}
+PlaneSearch::PlaneSearch(const PatchMatchParams& params, ViewState& self, const ViewState& other,
+                         const SearchOptions& options)
+    : p_(params), self_(self), cost_(params, self, other), options_(options) {}
 
 bool PlaneSearch::admissible(int x, int y, float d) const {
   if (!(d >= self_.d_min && d <= self_.d_max)) return false;
@@ -88,8 +89,10 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   if (ny >= 0 && ny < self_.height) {
     tryPlane(x, y, self_.planes[idx + step * self_.width], cache, best, best_cost);
   }
-  Rng rng(streamKey(p_.seed, self_.match_sign < 0 ? 0 : 1, iteration, idx));
-  refine(x, y, cache, rng, best, best_cost);
+  if (options_.refine) {
+    Rng rng(streamKey(p_.seed, self_.match_sign < 0 ? 0 : 1, iteration, idx));
+    refine(x, y, cache, rng, best, best_cost);
+  }
   self_.planes[idx] = best;
   self_.cost[idx] = best_cost;
 }
@@ -128,10 +131,10 @@ void PlaneSearch::tryPlane(int x, int y, const Plane& candidate, const WindowCac
 void PlaneSearch::refine(int x, int y, const WindowCache& cache, Rng& rng, Plane& best,
                          float& best_cost) const {
   float dd;
-  if (p_.use_lidar_bounds && self_.bounded(x, y)) {
-    dd = std::max(self_.range(y, x), static_cast<float>(p_.min_refine_range));
-  } else if (!self_.guide.empty()) {
+  if (!self_.guide.empty()) {
     dd = static_cast<float>(p_.fine_refine_range);  // the coarse start found the neighbourhood
+  } else if (p_.use_lidar_bounds && self_.bounded(x, y)) {
+    dd = std::max(self_.range(y, x), static_cast<float>(p_.min_refine_range));
   } else {
     dd = 0.5f * (self_.d_max - self_.d_min);
   }
@@ -158,6 +161,32 @@ void PlaneSearch::refine(int x, int y, const WindowCache& cache, Rng& rng, Plane
     dd *= 0.5f;
     dn *= 0.5f;
   }
+  if (options_.subpixel) subpixelStep(x, y, cache, best, best_cost);
+}
+
+void PlaneSearch::subpixelStep(int x, int y, const WindowCache& cache, Plane& best,
+                               float& best_cost) const {
+  const float h = kMinRefineStep;
+  const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+  const Plane lower{best.a, best.b, best.c - h}, upper{best.a, best.b, best.c + h};
+  if (!admissible(x, y, lower.at(fx, fy)) || !admissible(x, y, upper.at(fx, fy))) return;
+  const float unbounded = std::numeric_limits<float>::max();  // the fit needs the full costs
+  const float c_lower = cost_.aggregate(cache, lower, unbounded);
+  const float c_upper = cost_.aggregate(cache, upper, unbounded);
+  const float curvature = c_lower - 2.f * best_cost + c_upper;
+  if (!(curvature > 0.f)) {  // no minimum between the two: keep the cheapest of the three
+    if (c_lower < best_cost) {
+      best = lower;
+      best_cost = c_lower;
+    }
+    if (c_upper < best_cost) {
+      best = upper;
+      best_cost = c_upper;
+    }
+    return;
+  }
+  const float t = 0.5f * h * (c_lower - c_upper) / curvature;
+  if (std::abs(t) < h) tryPlane(x, y, Plane{best.a, best.b, best.c + t}, cache, best, best_cost);
 }
 
 int threadCount(const PatchMatchParams& p) {

@@ -45,6 +45,10 @@ struct WindowCache {
   void reserve(size_t n);
 };
 
+/// The window offsets used in x and in y, ascending: the multiples of `stride` within `radius`, or
+/// with `dyadic` 0, +-stride, +-2 stride, +-4 stride, ... within `radius`.
+std::vector<int> windowOffsets(int radius, int stride, bool dyadic);
+
 class MatchingCost {
  public:
   /// Uses the AVX2 kernel when activeSimdPath() is kAvx2 and both views have texels.
@@ -63,7 +67,7 @@ class MatchingCost {
   /// Whether this cost runs the AVX2 kernel.
   bool usesAvx2() const { return avx2_; }
 
-  /// The window offsets used in x and y (multiples of window_stride within window_radius).
+  /// The window offsets used in x and y (windowOffsets of the parameters).
   const std::vector<int>& offsets() const { return offsets_; }
 
  private:

@@ -5,9 +5,14 @@
 // Readings taken here:
 //  * A plane is accepted for pixel p only if its disparity at p lies in [lo(p), hi(p)] from the
 //    scan lines above and below (plus bound_margin), and always in [d_min, d_max] of the image.
+//  * At the full-size level after a coarse start, d's random refinement ends with a parabolic
+//    sub-pixel step (subpixelStep) in the left view, and the right view is searched by
+//    propagation only (PatchMatchParams::fine_subpixel, fine_right_view).
 //  * Refinement starts from Delta_d_max = max(|d_up - d_down|, min_refine_range) between scan
 //    lines (else half the image's disparity range), Delta_n_max = 1; both halve until
-//    Delta_d_max < 0.1 px.
+//    Delta_d_max < 0.1 px. At a level that starts from the planes of a coarser one (coarse
+//    start), every pixel refines from fine_refine_range instead: the coarse level has searched
+//    the bounds already.
 //  * Locked pixels (prior confidence >= lock_confidence) keep the prior's plane: they are not
 //    searched and receive no view propagation, but offer their plane to their neighbours.
 //  * Parallelism: the image is cut into horizontal strips of kStripRows rows processed in two
@@ -25,9 +30,16 @@
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
+/// How a level searches one view (the driver decides per level and view, patchmatch.cpp).
+struct SearchOptions {
+  bool refine = true;     ///< plane refinement after spatial propagation (false: propagation only)
+  bool subpixel = false;  ///< refinement ends with subpixelStep()
+};
+
 class PlaneSearch {
  public:
-  PlaneSearch(const PatchMatchParams& params, ViewState& self, const ViewState& other);
+  PlaneSearch(const PatchMatchParams& params, ViewState& self, const ViewState& other,
+              const SearchOptions& options = SearchOptions());
 
   const MatchingCost& cost() const { return cost_; }
 
@@ -57,9 +69,16 @@ class PlaneSearch {
   /// first call after initialisation.
   float currentCost(int idx, const WindowCache& cache) const;
 
-  /// Plane refinement (random perturbations of d and n, halving ranges).
+  /// Plane refinement (random perturbations of d and n, halving ranges), then subpixelStep()
+  /// when the options ask for it.
   void refine(int x, int y, const WindowCache& cache, Rng& rng, Plane& best,
               float& best_cost) const;
+
+  /// Sub-pixel step on d with the normal kept: the parabola through the costs of the planes
+  /// shifted by -h, 0 and +h (h = kMinRefineStep, d's last refinement step) has its vertex at
+  /// shift t = h (C(-h) - C(+h)) / (2 (C(-h) - 2 C(0) + C(+h))); the plane shifted by t (|t| < h)
+  /// replaces the best if it costs less, or the cheaper of +-h where the costs do not curve up.
+  void subpixelStep(int x, int y, const WindowCache& cache, Plane& best, float& best_cost) const;
 
  private:
   void initRange(int x, int y, float& lo, float& hi) const;
@@ -71,6 +90,7 @@ class PlaneSearch {
   const PatchMatchParams& p_;
   ViewState& self_;
   MatchingCost cost_;
+  SearchOptions options_;
 };
 
 constexpr int kStripRows = 12;
