@@ -269,6 +269,34 @@ TEST(PatchMatchViewPropagation, AGoodLeftPlaneReachesItsMatchInTheRightView) {
   EXPECT_FLOAT_EQ(v.right.planes[10 * 80 + 78].c, 20.f);
 }
 
+TEST(PatchMatchViewPropagation, OfferedPlanesAreTriedWhenTheSweepVisitsAndTheNearerSurfaceWins) {
+  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(80, 20, 0.0, 0.0, 6.0, 9);
+  lsf::PatchMatchParams p = params3x3();
+  p.window_radius = 2;
+  Views v = prepare({s.left}, {s.right}, p);
+  pm::SearchOptions propagation_only;
+  propagation_only.refine = false;
+  const pm::PlaneSearch right_search(p, v.right, v.left, propagation_only);
+  for (auto& plane : v.left.planes) plane = pm::Plane{0.f, 0.f, 6.f};
+  // Left pixel 44 (d 4) and left pixel 46 (d 6) both match right pixel 40: 46 is the nearer.
+  v.left.planes[10 * 80 + 44] = pm::Plane{0.f, 0.f, 4.f};
+  for (size_t i = 0; i < v.right.planes.size(); ++i) {
+    v.right.planes[i] = pm::Plane{0.f, 0.f, 20.f};
+    v.right.cost[i] = pm::kUnknownCost;
+  }
+  pm::offerView(v.left, right_search, v.right, p, true);
+  const int idx = 10 * 80 + 40;
+  ASSERT_TRUE(v.right.offered[idx]);
+  EXPECT_EQ(v.right.offer[idx].c, 6.f);
+  EXPECT_EQ(v.right.planes[idx].c, 20.f);  // nothing evaluated yet
+  EXPECT_FALSE(v.right.offered[10 * 80 + 78]);  // no left pixel maps there
+  pm::WindowCache cache;
+  right_search.processPixel(40, 10, true, 0, cache);
+  EXPECT_EQ(v.right.planes[idx].c, 6.f);
+  EXPECT_LT(v.right.cost[idx], 1e-2f);
+  EXPECT_FALSE(v.right.offered[idx]);  // withdrawn once tried
+}
+
 TEST(PatchMatchPostProcessing, LeftRightCheckMarksDisagreementsAndKeepsWhatItCannotCheck) {
   cv::Mat1f left(1, 8, 2.f), right(1, 8, 2.f);
   right(0, 3) = 5.f;  // left pixel 5 (d = 2) matches right pixel 3: disagrees by 3

@@ -140,7 +140,15 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   for (int it = 0; it < iterations; ++it) {
     sweep(left_search, lv, p, it);
     if (!two_views || it < iterations - right_iterations) continue;
-    if (p.view_propagation) propagateView(lv, right_search, rv, p, true);
+    if (p.view_propagation) {
+      // A right view swept by propagation alone tries the left planes in its sweep, with the
+      // windows the sweep builds anyway; a refined one gets every plane (Bleyer).
+      if (right_options.refine) {
+        propagateView(lv, right_search, rv, p, true);
+      } else {
+        offerView(lv, right_search, rv, p, true);
+      }
+    }
     sweep(right_search, rv, p, it);
     if (p.view_propagation) propagateView(rv, left_search, lv, p, false);
   }

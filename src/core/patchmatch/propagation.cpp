@@ -82,6 +82,10 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   cost_.buildWindow(x, y, cache);
   Plane best = self_.planes[idx];
   float best_cost = currentCost(idx, cache);
+  if (self_.offered[idx]) {  // view propagation (offerView)
+    tryPlane(x, y, self_.offer[idx], cache, best, best_cost);
+    self_.offered[idx] = 0;
+  }
   // Spatial propagation: forward sweeps look left/up, backward sweeps right/down.
   const int step = forward ? -1 : 1;
   const int nx = x + step, ny = y + step;
@@ -140,7 +144,9 @@ void PlaneSearch::refine(int x, int y, const WindowCache& cache, Rng& rng, Plane
   }
   float dn = 1.f;
   const float fx = static_cast<float>(x), fy = static_cast<float>(y);
-  while (dd >= kMinRefineStep) {
+  // With the sub-pixel step, the last halving (to below 2 kMinRefineStep) is its job.
+  const float stop = options_.subpixel ? 2.f * kMinRefineStep : kMinRefineStep;
+  while (dd >= stop) {
     const float d = best.at(fx, fy) + rng.uniform(-dd, dd);
     Plane candidate{0.f, 0.f, d};
     if (p_.slanted) {

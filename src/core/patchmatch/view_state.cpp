@@ -162,6 +162,8 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
   v.planes.assign(n, Plane{});
   v.cost.assign(n, 0.f);
   v.locked.assign(n, 0);
+  v.offer.assign(n, Plane{});
+  v.offered.assign(n, 0);
   v.guide.clear();
   const float lock = static_cast<float>(p.lock_confidence);
   if (v.trust.empty() || !p.confidence_weighting || lock > 1.f) return;

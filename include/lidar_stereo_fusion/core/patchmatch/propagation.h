@@ -70,7 +70,7 @@ class PlaneSearch {
   float currentCost(int idx, const WindowCache& cache) const;
 
   /// Plane refinement (random perturbations of d and n, halving ranges), then subpixelStep()
-  /// when the options ask for it.
+  /// when the options ask for it (which replaces the last halving).
   void refine(int x, int y, const WindowCache& cache, Rng& rng, Plane& best,
               float& best_cost) const;
 
@@ -108,6 +108,13 @@ void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, i
 /// the pixel it matches in `dst`. Rows are independent, so rows run in parallel.
 void propagateView(const ViewState& src, const PlaneSearch& dst_search, ViewState& dst,
                    const PatchMatchParams& p, bool left_to_right);
+
+/// View propagation before a sweep of `dst`: as propagateView, but each plane is only offered
+/// (ViewState::offer) and tried when the sweep visits its pixel, with the window the visit builds
+/// anyway. Of several planes offered to one pixel, the one of the nearer surface is kept (the
+/// source pixel that comes last in visibility order): it is the surface that view sees.
+void offerView(const ViewState& src, const PlaneSearch& dst_search, ViewState& dst,
+               const PatchMatchParams& p, bool left_to_right);
 
 /// Threads to use (num_threads, or all cores for 0).
 int threadCount(const PatchMatchParams& p);

@@ -37,6 +37,10 @@ struct ViewState {
   std::vector<uint8_t> locked;
   /// Planes of the coarse start, up-sampled (empty: none): the initial plane where admissible.
   std::vector<Plane> guide;
+  /// Planes handed over by view propagation before this view's sweep (offerView): `offer[i]` is
+  /// tried when the sweep visits pixel i if `offered[i]`, then withdrawn.
+  std::vector<Plane> offer;
+  std::vector<uint8_t> offered;
   /// The colour and gradient as the AVX2 cost reads them: kTexelFloats per pixel, row-major
   /// (B, G, R, 0, gx, gy, 0, 0). Empty on the baseline path.
   std::vector<Texel> texels;
