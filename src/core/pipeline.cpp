@@ -2,6 +2,7 @@
 #include "lidar_stereo_fusion/core/pipeline.h"
 
 #include <chrono>
+#include <future>
 #include <stdexcept>
 
 namespace lidar_stereo_fusion {
@@ -190,6 +191,13 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
   // Stage 2: up-sampling (and the prior's confidence).
   auto t = Clock::now();
   ViewPrior left_prior, right_prior;
+  // The right view's prior is made beside the left's when more than one thread may run (its
+  // exceptions reach the caller through the future; its destructor waits if the left throws).
+  std::future<ViewPrior> right_future;
+  if (fused && params_.patchmatch.num_threads != 1) {
+    right_future = std::async(std::launch::async,
+                              [&] { return upsampleView(right_sparse, right_image, params_); });
+  }
   if (usesLidar(method)) {
     left_prior = upsampleView(left_sparse, left_image, params_);
     stats.points_removed = left_prior.removed;
@@ -197,7 +205,11 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
     result.confidence = left_prior.confidence;
     stats.prior_coverage = coverage(result.prior);
   }
-  if (fused) right_prior = upsampleView(right_sparse, right_image, params_);
+  if (right_future.valid()) {
+    right_prior = right_future.get();
+  } else if (fused) {
+    right_prior = upsampleView(right_sparse, right_image, params_);
+  }
   stats.upsampling_ms = msSince(t);
 
   // Stage 3: PatchMatch.
