@@ -45,6 +45,7 @@ NodeParams NodeParams::read(const ros::NodeHandle& pnh) {
   readChecked(pnh, "cloud_stride", p.cloud_stride, positive, "must be > 0");
   readChecked(pnh, "max_output_depth", p.max_output_depth, non_negative, "must be >= 0 [m]");
   readChecked(pnh, "max_rate", p.max_rate, non_negative, "must be >= 0 [Hz] (0 = no limit)");
+  readChecked(pnh, "input_timeout", p.input_timeout, non_negative, "must be >= 0 [s] (0 = off)");
   readChecked(
       pnh, "worker_nice", p.worker_nice, [](int v) { return v >= 0 && v <= 19; },
       "must be in [0, 19]");

@@ -122,7 +122,7 @@ TEST_F(FusionNode, A_LazySubscription) {
   }
 
   // One subscriber on one output is enough; when it leaves, the inputs are dropped again.
-  for (const std::string output : {"stats", "depth", "points2"}) {
+  for (const std::string output : {"stats", "depth/image_rect", "points2"}) {
     h().subscribeOutputs({output});
     EXPECT_TRUE(h().inputsSubscribed(true, 10.0)) << "no input subscription for " << output;
     h().unsubscribeOutputs();
@@ -179,7 +179,7 @@ TEST_F(FusionNode, B_OneOutputPerInputSetOnEveryTopic) {
     EXPECT_LE(disparity->valid_window.x_offset + disparity->valid_window.width,
               static_cast<uint32_t>(kWidth));
 
-    auto depth = h().image("depth");
+    auto depth = h().image("depth/image_rect");
     ASSERT_TRUE(depth);
     EXPECT_EQ(depth->encoding, sensor_msgs::image_encodings::TYPE_32FC1);
     double median_rel = 1, coverage = 0;
