@@ -5,6 +5,8 @@
 #   fusion_nodelet.test      rostest of the nodelet (test_fusion_node: synthetic input, bad input,
 #   fusion_node.test           lazy subscription, TF, live parameters, diagnostics); the same test
 #   fusion_approx_sync.test    source against the node, and with approximate sync
+#   ros_conventions.test     depth_image_proc / stereo_image_proc nodelets consume the outputs by
+#                              remapping only; dynparam refusals; silent inputs named
 #   rviz_screenshot.test     RViz with rviz/fusion.rviz under Xvfb draws the fused cloud
 #   roslaunch-check          every launch file in launch/
 
@@ -44,8 +46,13 @@ add_rostest(test/ros/fusion_node.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_approx_sync.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_max_rate.test DEPENDENCIES test_fusion_node)
 
+# Issue 10: depth_image_proc / stereo_image_proc consume the outputs by remapping only; dynparam
+# refusals are visible; silent inputs are named.
+lsf_add_ros_test_node(test_ros_conventions test/ros/test_ros_conventions.cpp test/ros/run_command.cpp)
+add_rostest(test/ros/ros_conventions.test DEPENDENCIES test_ros_conventions)
+
 # RViz with rviz/fusion.rviz under Xvfb: the fused cloud is drawn (screenshots in the build folder).
-lsf_add_ros_test_node(test_rviz_screenshot test/ros/test_rviz_screenshot.cpp)
+lsf_add_ros_test_node(test_rviz_screenshot test/ros/test_rviz_screenshot.cpp test/ros/child_process.cpp)
 add_rostest(test/ros/rviz_screenshot.test DEPENDENCIES test_rviz_screenshot)
 
 # The simulated street as a live rig: demos, the RViz check, latency and rate measurements.

@@ -57,6 +57,8 @@ class Harness {
     process_node_ = pnh_.param<std::string>("process_node", "/fusion/fusion_manager");
     fusion_node_ = pnh_.param<std::string>("fusion_node", "/fusion/fusion");
     ns_ = pnh_.param<std::string>("fusion_ns", "/fusion");
+    // stereo_image_proc (image_geometry) needs both camera_infos in one frame: the left one.
+    right_frame_ = pnh_.param<std::string>("right_frame", kRightCameraFrame);
     frames_ = lsf::test::makeFrames(3, kWidth, kHeight);
     left_image_ = nh_.advertise<sensor_msgs::Image>("/stereo/left/image_rect_color", 5);
     left_info_ = nh_.advertise<sensor_msgs::CameraInfo>("/stereo/left/camera_info", 5);
@@ -142,9 +144,9 @@ class Harness {
       right_camera.width = spec.right_width;
     }
     auto right =
-        lsf::test::imageMsg(right_bgr, spec.right_encoding, kRightCameraFrame, right_stamp);
+        lsf::test::imageMsg(right_bgr, spec.right_encoding, right_frame_, right_stamp);
     auto linfo = lsf::test::cameraInfoMsg(frame.camera, false, kCameraFrame, stamp);
-    auto rinfo = lsf::test::cameraInfoMsg(right_camera, true, kRightCameraFrame, right_stamp,
+    auto rinfo = lsf::test::cameraInfoMsg(right_camera, true, right_frame_, right_stamp,
                                           spec.positive_tx);
     auto cloud = makeCloud(spec, stamp);
     if (cloud && spec.cloud_first) cloud_.publish(cloud);
@@ -314,7 +316,7 @@ class Harness {
   }
 
   ros::NodeHandle nh_, pnh_;
-  std::string process_node_, fusion_node_, ns_;
+  std::string process_node_, fusion_node_, ns_, right_frame_;
   std::vector<lsf::sim::SyntheticFrame> frames_;
   ros::Publisher left_image_, left_info_, right_image_, right_info_, cloud_;
   tf2_ros::StaticTransformBroadcaster tf_broadcaster_;
