@@ -439,6 +439,11 @@ sensor_msgs::ImagePtr depthToMsg(const cv::Mat1f& depth, const std_msgs::Header&
   return msg;
 }
 
+sensor_msgs::ImagePtr bgrImageToMsg(const cv::Mat& image, const std_msgs::Header& header) {
+  if (image.type() != CV_8UC3) throw ConversionError("bgrImageToMsg: image must be CV_8UC3");
+  return cv_bridge::CvImage(header, sensor_msgs::image_encodings::BGR8, image).toImageMsg();
+}
+
 sensor_msgs::ImagePtr floatImageToMsg(const cv::Mat1f& image, const std_msgs::Header& header) {
   return boost::make_shared<sensor_msgs::Image>(floatImage(image, header));
 }

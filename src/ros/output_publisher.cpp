@@ -6,6 +6,7 @@
 #include <boost/make_shared.hpp>
 
 #include "lidar_stereo_fusion/core/depth.h"
+#include "lidar_stereo_fusion/io/visualization.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
 
 namespace lidar_stereo_fusion {
@@ -101,6 +102,7 @@ void OutputPublisher::advertise() {
   pub_stats_ = nh_.advertise<FusionStats>("stats", 10, ros_cb, ros_cb);
   // depth/image_rect + depth/camera_info, as depth_image_proc and image_transport pair them.
   pub_depth_ = it_->advertiseCamera("depth/image_rect", 1, it_cb, it_cb, ros_cb, ros_cb);
+  pub_depth_color_ = it_->advertise("depth/image_color", 1, it_cb, it_cb);
   pub_lidar_disparity_ = it_->advertise("lidar_disparity", 1, it_cb, it_cb);
   pub_disparity_image_ = it_->advertise("disparity_image", 1, it_cb, it_cb);
   pub_confidence_ = it_->advertise("confidence", 1, it_cb, it_cb);
@@ -119,7 +121,7 @@ void OutputPublisher::connectCb() {
   const uint32_t subscribers =
       pub_disparity_.getNumSubscribers() + pub_points_.getNumSubscribers() +
       pub_stats_.getNumSubscribers() + pub_depth_.getNumSubscribers() +
-      pub_lidar_disparity_.getNumSubscribers() +
+      pub_depth_color_.getNumSubscribers() + pub_lidar_disparity_.getNumSubscribers() +
       pub_disparity_image_.getNumSubscribers() + pub_confidence_.getNumSubscribers();
   if (subscribers == 0 && gate_.subscribed()) {
     gate_.unsubscribe();
@@ -138,7 +140,7 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
     depth = disparityToDepth(result.disparity, camera);
 
   stereo_msgs::DisparityImagePtr disparity_msg;
-  sensor_msgs::ImagePtr depth_msg, prior_msg, disparity_image_msg, confidence_msg;
+  sensor_msgs::ImagePtr depth_msg, depth_color_msg, prior_msg, disparity_image_msg, confidence_msg;
   sensor_msgs::CameraInfoPtr depth_info;
   sensor_msgs::PointCloud2Ptr points_msg;
   if (pub_disparity_.getNumSubscribers() > 0) {
@@ -159,6 +161,12 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
     depth_msg = conversions::depthToMsg(depth, header);
     depth_info = boost::make_shared<sensor_msgs::CameraInfo>(*match.images.left_info);
     depth_info->header = header;
+  }
+  if (pub_depth_color_.getNumSubscribers() > 0) {
+    // For RViz's Image display: colours with a scale bar in metres (a grey 32FC1 has no legend).
+    const double max = params_.depth_color_max;
+    depth_color_msg =
+        conversions::bgrImageToMsg(withColorBar(colorizeDepth(depth, max), max, 0.0, "m"), header);
   }
   if (pub_lidar_disparity_.getNumSubscribers() > 0) {
     const cv::Mat1f prior =
@@ -182,6 +190,7 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
   const ros::Time publish_time = ros::Time::now();
   if (disparity_msg) pub_disparity_.publish(disparity_msg);
   if (depth_msg) pub_depth_.publish(depth_msg, depth_info);
+  if (depth_color_msg) pub_depth_color_.publish(depth_color_msg);
   if (disparity_image_msg) pub_disparity_image_.publish(disparity_image_msg);
   if (prior_msg) pub_lidar_disparity_.publish(prior_msg);
   if (confidence_msg) pub_confidence_.publish(confidence_msg);

@@ -33,8 +33,9 @@ constexpr double kNoOutputWait = 1.5;    ///< [s] > max_sweep_wait + processing 
 
 /// The output topics, relative to the fusion namespace.
 const std::vector<std::string> kOutputs = {
-    "disparity",       "depth/image_rect", "depth/camera_info", "points2",
-    "lidar_disparity", "disparity_image", "confidence",        "stats"};
+    "disparity",       "depth/image_rect", "depth/camera_info", "depth/image_color",
+    "points2",         "lidar_disparity",  "disparity_image",   "confidence",
+    "stats"};
 
 /// How one input set is made.
 struct SetSpec {

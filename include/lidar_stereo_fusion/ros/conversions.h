@@ -96,6 +96,9 @@ stereo_msgs::DisparityImagePtr disparityToMsg(const cv::Mat1f& disparity,
 sensor_msgs::ImagePtr depthToMsg(const cv::Mat1f& depth, const std_msgs::Header& header,
                                  double max_depth = 0.0);
 
+/// A BGR8 picture (CV_8UC3) as a bgr8 image (copied).
+sensor_msgs::ImagePtr bgrImageToMsg(const cv::Mat& image, const std_msgs::Header& header);
+
 /// A float map as a 32FC1 image, unchanged (e.g. the LiDAR prior: disparity [px], 0 = empty).
 sensor_msgs::ImagePtr floatImageToMsg(const cv::Mat1f& image, const std_msgs::Header& header);
 

@@ -32,6 +32,7 @@ struct NodeParams {
   int num_rings = 64;             ///< beams of the LiDAR (ring recovery; see ensureRings)
   int cloud_stride = 1;           ///< points2 keeps every k-th pixel in rows and columns
   double max_output_depth = 0.0;  ///< [m] depth / points2 beyond this are empty (0 = no limit)
+  double depth_color_max = 80.0;  ///< [m] depth/image_color: the far end of the colour scale
   /// [Hz] image sets stamped closer than 0.9 / max_rate after the last accepted one are dropped on
   /// arrival, counted (FusionStats.rate_limited) and not warned about. 0 = no limit.
   double max_rate = 0.0;

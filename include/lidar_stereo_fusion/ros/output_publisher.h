@@ -85,6 +85,7 @@ class OutputPublisher {
   std::shared_ptr<image_transport::ImageTransport> it_;
   ros::Publisher pub_disparity_, pub_points_, pub_stats_;
   image_transport::CameraPublisher pub_depth_;  ///< depth/image_rect + depth/camera_info
+  image_transport::Publisher pub_depth_color_;   ///< depth/image_color
   image_transport::Publisher pub_lidar_disparity_, pub_disparity_image_, pub_confidence_;
 
   diagnostic_updater::Updater updater_;
