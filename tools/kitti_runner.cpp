@@ -150,11 +150,11 @@ void saveVisualisation(const fs::path& dir, const std::string& name, const cv::M
              lsf::withColorBar(lsf::colorizeDepth(result.depth, kMaxDepth), kMaxDepth, 0, "m"));
   if (reference) {
     constexpr double kMaxError = 5.0;  ///< [px] colorizeError's scale
-    writeImage(dir / (name + "_error.png"),
-               lsf::withColorBar(lsf::colorizeError(result.disparity,
-                                                    lsf::depthToDisparity(*reference, camera),
-                                                    kMaxError),
-                                 0, kMaxError, "px error"));
+    writeImage(
+        dir / (name + "_error.png"),
+        lsf::withColorBar(lsf::colorizeError(result.disparity,
+                                             lsf::depthToDisparity(*reference, camera), kMaxError),
+                          0, kMaxError, "px error"));
   }
 }
 

@@ -106,24 +106,30 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
     exact_sync_->registerCallback(boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4));
     exact_sync_->registerDropCallback(boost::bind(&InputGate::syncDropCb, this, _1, _2, _3, _4));
   }
-  // Every input topic's arrivals, for the watch (indices as in watch_'s list); the cloud's in cloudCb.
-  sub_left_image_.registerCallback(
-      boost::function<void(const sensor_msgs::ImageConstPtr&)>([this](const auto&) { watch_.heard(0); }));
-  sub_left_info_.registerCallback(
-      boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>([this](const auto&) { watch_.heard(1); }));
-  sub_right_image_.registerCallback(
-      boost::function<void(const sensor_msgs::ImageConstPtr&)>([this](const auto&) { watch_.heard(2); }));
-  sub_right_info_.registerCallback(
-      boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>([this](const auto&) { watch_.heard(3); }));
+  // Every input topic's arrivals, for the watch (indices as in watch_'s list); the cloud's in
+  // cloudCb.
+  sub_left_image_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
+      [this](const auto&) { watch_.heard(0); }));
+  sub_left_info_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
+      [this](const auto&) { watch_.heard(1); }));
+  sub_right_image_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
+      [this](const auto&) { watch_.heard(2); }));
+  sub_right_info_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
+      [this](const auto&) { watch_.heard(3); }));
   if (params_.input_timeout > 0.0) {
     watch_timer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
       watch_.check([this](std::size_t i) -> uint32_t {
         switch (i) {
-          case 0: return sub_left_image_.getSubscriber().getNumPublishers();
-          case 1: return sub_left_info_.getSubscriber().getNumPublishers();
-          case 2: return sub_right_image_.getSubscriber().getNumPublishers();
-          case 3: return sub_right_info_.getSubscriber().getNumPublishers();
-          default: return sub_cloud_.getNumPublishers();
+          case 0:
+            return sub_left_image_.getSubscriber().getNumPublishers();
+          case 1:
+            return sub_left_info_.getSubscriber().getNumPublishers();
+          case 2:
+            return sub_right_image_.getSubscriber().getNumPublishers();
+          case 3:
+            return sub_right_info_.getSubscriber().getNumPublishers();
+          default:
+            return sub_cloud_.getNumPublishers();
         }
       });
     });

@@ -83,8 +83,8 @@ OutputPublisher::OutputPublisher(const ros::NodeHandle& nh, const ros::NodeHandl
   updater_.add("processing", this, &OutputPublisher::diagnoseProcessing);
   // A wall-clock timer and force_update(): Updater::update() and ROS timers wait for ROS time to
   // pass the next period, which after a bag loop (simulated time jumps back) takes a whole loop.
-  diag_timer_ = nh_.createWallTimer(ros::WallDuration(1.0),
-                                    [this](const ros::WallTimerEvent&) { updater_.force_update(); });
+  diag_timer_ = nh_.createWallTimer(
+      ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { updater_.force_update(); });
 }
 
 OutputPublisher::~OutputPublisher() { shutdown(); }

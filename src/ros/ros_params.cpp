@@ -137,7 +137,9 @@ Entry* findEntry(std::vector<Entry>& entries, const std::string& name) {
 /// Writes FusionParams into a dynamic_reconfigure::Config message.
 struct ToMessage {
   dynamic_reconfigure::Config& msg;
-  void operator()(const ParamName& n, const double& v) { findEntry(msg.doubles, n.name)->value = v; }
+  void operator()(const ParamName& n, const double& v) {
+    findEntry(msg.doubles, n.name)->value = v;
+  }
   void operator()(const ParamName& n, const int& v) { findEntry(msg.ints, n.name)->value = v; }
   void operator()(const ParamName& n, const bool& v) { findEntry(msg.bools, n.name)->value = v; }
   void operator()(const ParamName& n, const Method& v) {
@@ -178,7 +180,8 @@ struct FromMessage {
 };
 
 /// Every entry of a Config message as name -> text.
-std::vector<std::pair<std::string, std::string>> messageEntries(const dynamic_reconfigure::Config& m) {
+std::vector<std::pair<std::string, std::string>> messageEntries(
+    const dynamic_reconfigure::Config& m) {
   std::vector<std::pair<std::string, std::string>> out;
   for (const auto& e : m.strs) out.emplace_back(e.name, e.value);
   for (const auto& e : m.doubles) out.emplace_back(e.name, formatParamDouble(e.value));

@@ -33,9 +33,9 @@ constexpr double kNoOutputWait = 1.5;    ///< [s] > max_sweep_wait + processing 
 
 /// The output topics, relative to the fusion namespace.
 const std::vector<std::string> kOutputs = {
-    "disparity",       "depth/image_rect", "depth/camera_info", "depth/image_color",
-    "points2",         "lidar_disparity",  "disparity_image",   "confidence",
-    "stats"};
+    "disparity",         "depth/image_rect", "depth/camera_info",
+    "depth/image_color", "points2",          "lidar_disparity",
+    "disparity_image",   "confidence",       "stats"};
 
 /// How one input set is made.
 struct SetSpec {
@@ -144,11 +144,10 @@ class Harness {
       right_bgr = frame.right(cv::Rect(0, 0, spec.right_width, frame.right.rows)).clone();
       right_camera.width = spec.right_width;
     }
-    auto right =
-        lsf::test::imageMsg(right_bgr, spec.right_encoding, right_frame_, right_stamp);
+    auto right = lsf::test::imageMsg(right_bgr, spec.right_encoding, right_frame_, right_stamp);
     auto linfo = lsf::test::cameraInfoMsg(frame.camera, false, kCameraFrame, stamp);
-    auto rinfo = lsf::test::cameraInfoMsg(right_camera, true, right_frame_, right_stamp,
-                                          spec.positive_tx);
+    auto rinfo =
+        lsf::test::cameraInfoMsg(right_camera, true, right_frame_, right_stamp, spec.positive_tx);
     auto cloud = makeCloud(spec, stamp);
     if (cloud && spec.cloud_first) cloud_.publish(cloud);
     left_info_.publish(linfo);

@@ -15,9 +15,9 @@ namespace {
 
 /// The parameters roslaunch would set, as its YAML-like dump.
 std::string dumpParams(const std::string& launch, const std::string& args = "") {
-  const auto [status, output] = lt::runCommand("/usr/bin/python3 /usr/bin/roslaunch --dump-params " +
-                                               std::string(LSF_SOURCE_DIR) + "/launch/" + launch +
-                                               " " + args);
+  const auto [status, output] =
+      lt::runCommand("/usr/bin/python3 /usr/bin/roslaunch --dump-params " +
+                     std::string(LSF_SOURCE_DIR) + "/launch/" + launch + " " + args);
   EXPECT_EQ(status, 0) << output;
   return output;
 }

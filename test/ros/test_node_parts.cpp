@@ -134,13 +134,15 @@ TEST(InputWatch, NamesSilentTopicsAfterTheTimeout) {
   lsf::InputWatch watch({"/a", "/b"}, 2.0, log);
   using Clock = lsf::InputWatch::Clock;
   const Clock::time_point t0 = Clock::now();
-  const auto at = [&](double s) { return t0 + std::chrono::milliseconds(static_cast<int>(s * 1e3)); };
+  const auto at = [&](double s) {
+    return t0 + std::chrono::milliseconds(static_cast<int>(s * 1e3));
+  };
   const auto none = [](std::size_t) { return 0u; };
   EXPECT_TRUE(watch.check(none, at(10)).empty()) << "not watching before start()";
   watch.start(at(0));
   watch.heard(0, at(0.5));
   EXPECT_TRUE(watch.check(none, at(1.9)).empty());
-  EXPECT_EQ(watch.check(none, at(2.1)), (std::vector<std::size_t>{1}));  // /b never sent
+  EXPECT_EQ(watch.check(none, at(2.1)), (std::vector<std::size_t>{1}));     // /b never sent
   EXPECT_EQ(watch.check(none, at(2.6)), (std::vector<std::size_t>{0, 1}));  // /a quiet for 2.1 s
   watch.heard(0, at(3.0));
   watch.heard(1, at(3.0));

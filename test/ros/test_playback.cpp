@@ -118,8 +118,8 @@ TEST(Playback, LoopedBagKeepsLatencyPositiveAndDiagnosticsFlowing) {
   double last_clock = 0;
   std::vector<float> latencies;
   int stats_after_second_loop = 0, diagnostics_after_second_loop = 0;
-  auto clock_sub = nh.subscribe<rosgraph_msgs::Clock>(
-      "/clock", 100, [&](const rosgraph_msgs::ClockConstPtr& c) {
+  auto clock_sub =
+      nh.subscribe<rosgraph_msgs::Clock>("/clock", 100, [&](const rosgraph_msgs::ClockConstPtr& c) {
         std::lock_guard<std::mutex> lock(mutex);
         const double t = c->clock.toSec();
         if (t + 0.5 < last_clock) ++loops;
@@ -150,9 +150,14 @@ TEST(Playback, LoopedBagKeepsLatencyPositiveAndDiagnosticsFlowing) {
   ASSERT_TRUE(lt::waitFor(180.0, [&] { return locked([&] { return loops >= 2; }); }))
       << "the bag did not loop twice (see " << log << ")";
   // Wall-clock span after the second loop: frames and 1 Hz diagnostics must keep coming.
-  EXPECT_TRUE(lt::waitFor(60.0, [&] {
-    return locked([&] { return stats_after_second_loop >= 1 && diagnostics_after_second_loop >= 3; });
-  })) << "after two loops: " << stats_after_second_loop << " stats, "
+  EXPECT_TRUE(lt::waitFor(60.0,
+                          [&] {
+                            return locked([&] {
+                              return stats_after_second_loop >= 1 &&
+                                     diagnostics_after_second_loop >= 3;
+                            });
+                          }))
+      << "after two loops: " << stats_after_second_loop << " stats, "
       << diagnostics_after_second_loop << " diagnostics from the fusion";
 
   // The Python message package is installed: rostopic can print a DiagnosticArray.

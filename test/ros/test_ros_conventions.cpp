@@ -152,7 +152,8 @@ TEST_F(RosConventions, B_OrganisedCloudPixelIsTheDepthPixel) {
         continue;
       }
       ++with_depth;
-      const float x = static_cast<float>((u - cx) * z / fx), y = static_cast<float>((v - cy) * z / fy);
+      const float x = static_cast<float>((u - cx) * z / fx),
+                  y = static_cast<float>((v - cy) * z / fy);
       if (std::abs(p[2] - z) > 1e-5f * z || std::abs(p[0] - x) > 1e-4f * z ||
           std::abs(p[1] - y) > 1e-4f * z) {
         ++wrong;
@@ -261,8 +262,8 @@ TEST_F(RosConventions, E_DynparamRefusalsAreVisibleAndTheValueInForceIsShown) {
   // The system Python (a pyenv or conda python3 first on PATH cannot import rospy).
   const std::string dynparam = "/usr/bin/python3 /usr/lib/dynamic_reconfigure/dynparam";
   const auto get = [&] { return lt::runCommand(dynparam + " get " + node).second; };
-  const std::string window = "'window_radius': " +
-                             std::to_string(lidar_stereo_fusion::PatchMatchParams().window_radius);
+  const std::string window =
+      "'window_radius': " + std::to_string(lidar_stereo_fusion::PatchMatchParams().window_radius);
   ASSERT_NE(get().find(window), std::string::npos) << get();
 
   // A misspelled name: dynparam itself refuses it, naming it.
@@ -272,8 +273,8 @@ TEST_F(RosConventions, E_DynparamRefusalsAreVisibleAndTheValueInForceIsShown) {
   // An invalid value: the node refuses it, logs why, and the value in force stays.
   std::size_t mark = h().logMark();
   std::tie(status, out) = lt::runCommand(dynparam + " set " + node + " window_radius 0");
-  EXPECT_TRUE(h().waitForLog(mark, {"refused", "window_radius must be in [1, 50]",
-                                    "window_radius = 0 (in force: "}))
+  EXPECT_TRUE(h().waitForLog(
+      mark, {"refused", "window_radius must be in [1, 50]", "window_radius = 0 (in force: "}))
       << out << h().logsSince(mark);
   EXPECT_NE(get().find(window), std::string::npos) << get();
 

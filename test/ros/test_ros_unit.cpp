@@ -583,7 +583,8 @@ TEST(RosParams, ReconfigureHasExactlyTheTableWithTheSameNamesAndGroups) {
   const auto entries = configEntries(lsf::FusionConfig::__getDefault__());
   std::map<std::string, std::string> cfg_group;
   for (const auto& g : lsf::FusionConfig::__getDescriptionMessage__().groups) {
-    for (const auto& param : g.parameters) cfg_group[param.name] = g.name == "Default" ? "" : g.name;
+    for (const auto& param : g.parameters)
+      cfg_group[param.name] = g.name == "Default" ? "" : g.name;
   }
   std::set<std::string> listed;
   for (const auto& info : lsf::ros_params::listParams()) {
@@ -593,7 +594,8 @@ TEST(RosParams, ReconfigureHasExactlyTheTableWithTheSameNamesAndGroups) {
     EXPECT_EQ(cfg_group[info.name], info.group) << info.name << ": group in cfg/Fusion.cfg";
   }
   for (const auto& kv : entries) {
-    EXPECT_TRUE(listed.count(kv.first)) << kv.first << " in cfg/Fusion.cfg is not in io/param_table.h";
+    EXPECT_TRUE(listed.count(kv.first))
+        << kv.first << " in cfg/Fusion.cfg is not in io/param_table.h";
   }
 }
 
@@ -634,8 +636,8 @@ TEST(RosParams, ConfigRoundTripKeepsEveryField) {
   EXPECT_EQ(q.method, lsf::Method::kFusedBF);
   EXPECT_EQ(q.patchmatch.seed, 1234u);
   EXPECT_NE(lsf::ros_params::describeChanges(lsf::FusionParams(), p)
-                .find("window_radius: " +
-                      std::to_string(lsf::PatchMatchParams().window_radius) + " -> 9"),
+                .find("window_radius: " + std::to_string(lsf::PatchMatchParams().window_radius) +
+                      " -> 9"),
             std::string::npos)
       << lsf::ros_params::describeChanges(lsf::FusionParams(), p);
 }

@@ -5,11 +5,11 @@
 //
 // Outputs (relative to the node handle): disparity (stereo_msgs/DisparityImage), depth/image_rect +
 // depth/camera_info (32FC1 [m], NaN = none), points2 (x, y, z, rgb, organised H x W, NaN = none),
-// depth/image_color (bgr8, the depth coloured with a scale bar in metres, for RViz), lidar_disparity (the
-// up-sampled prior, 32FC1 [px], 0 = empty), disparity_image (32FC1 [px], 0 = none, for RViz),
-// confidence (32FC1 in [0, 1], the prior's confidence, 0 = no prior; all 0 for methods without
-// LiDAR), stats (lidar_stereo_fusion/FusionStats), plus /diagnostics. Every output is in the left
-// optical frame and stamped with the left image stamp.
+// depth/image_color (bgr8, the depth coloured with a scale bar in metres, for RViz),
+// lidar_disparity (the up-sampled prior, 32FC1 [px], 0 = empty), disparity_image (32FC1 [px], 0 =
+// none, for RViz), confidence (32FC1 in [0, 1], the prior's confidence, 0 = no prior; all 0 for
+// methods without LiDAR), stats (lidar_stereo_fusion/FusionStats), plus /diagnostics. Every output
+// is in the left optical frame and stamped with the left image stamp.
 //
 // One lock (mutex_): the subscription state (serialising the gate's subscribe / unsubscribe) and
 // the windows of recent processing times.
@@ -85,7 +85,7 @@ class OutputPublisher {
   std::shared_ptr<image_transport::ImageTransport> it_;
   ros::Publisher pub_disparity_, pub_points_, pub_stats_;
   image_transport::CameraPublisher pub_depth_;  ///< depth/image_rect + depth/camera_info
-  image_transport::Publisher pub_depth_color_;   ///< depth/image_color
+  image_transport::Publisher pub_depth_color_;  ///< depth/image_color
   image_transport::Publisher pub_lidar_disparity_, pub_disparity_image_, pub_confidence_;
 
   diagnostic_updater::Updater updater_;
