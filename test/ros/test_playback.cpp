@@ -98,7 +98,12 @@ TEST(Playback, AtTheEndOfTheBagTheFusionAndRvizStay) {
   ASSERT_TRUE(lt::waitFor(120.0, [] { return !lt::nodeRegistered("/player"); }))
       << "the bag did not end";
   std::printf("bag ended; %d fused clouds so far\n", clouds.load());
-  ros::WallDuration(8.0).sleep();  // anything the end of the bag would end is gone by now
+  // RViz may still be starting on a slow machine: wait for it (a required player would have ended
+  // the whole launch by now, RViz with it), then give the end of the bag time to end anything.
+  EXPECT_TRUE(lt::waitFor(90.0, [] {
+    return lt::nodeRegistered("/rviz") && lt::hasSubscriber("/fusion/points2", "/rviz");
+  })) << "no RViz subscribed to the fused cloud after the end of the bag";
+  ros::WallDuration(8.0).sleep();
   EXPECT_TRUE(launch->running()) << "roslaunch ended with the bag";
   EXPECT_TRUE(lt::nodeRegistered("/fusion/fusion_manager"));
   EXPECT_TRUE(lt::nodeRegistered("/rviz")) << "RViz closed at the end of the bag";

@@ -111,7 +111,7 @@ TEST_F(RosConventions, A_SilentInputTopicIsNamed) {
   ASSERT_TRUE(h().inputsSubscribed(true, 10.0));
   SetSpec images_only;
   images_only.cloud = SetSpec::Cloud::kNone;
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(6.0);
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(15.0);
   bool named = false;
   while (ros::WallTime::now() < end && !named) {
     h().publishSet(images_only, h().nextStamp());
