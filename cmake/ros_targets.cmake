@@ -14,6 +14,7 @@ add_library(${PROJECT_NAME}_ros
   src/ros/ros_params.cpp
   src/ros/node_support.cpp
   src/ros/input_gate.cpp
+  src/ros/input_watch.cpp
   src/ros/output_publisher.cpp
   src/ros/fusion_worker.cpp
   src/ros/fusion_nodelet.cpp)

@@ -1,10 +1,13 @@
 # Tests of the ROS layer (nodelet, node, launch files, RViz config). Included after the core tests
 # when testing is enabled, with catkin set up and the ROS targets defined.
 #
-#   test_ros_unit            conversions, sweep matching, parameter mapping (no ROS master)
+#   test_ros_unit            conversions, sweep matching, parameter mapping, launch arguments
+#                            (no ROS master)
 #   fusion_nodelet.test      rostest of the nodelet (test_fusion_node: synthetic input, bad input,
 #   fusion_node.test           lazy subscription, TF, live parameters, diagnostics); the same test
 #   fusion_approx_sync.test    source against the node, and with approximate sync
+#   ros_conventions.test     depth_image_proc / stereo_image_proc nodelets consume the outputs by
+#                              remapping only; dynparam refusals; silent inputs named
 #   rviz_screenshot.test     RViz with rviz/fusion.rviz under Xvfb draws the fused cloud
 #   roslaunch-check          every launch file in launch/
 
@@ -15,7 +18,7 @@ set(LSF_ROS_TEST_DEFINITIONS
   LSF_BINARY_DIR="${CMAKE_CURRENT_BINARY_DIR}")
 
 catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp test/ros/test_input_attacks.cpp
-  test/ros/test_node_parts.cpp)
+  test/ros/test_node_parts.cpp test/ros/test_launch_files.cpp test/ros/run_command.cpp)
 if(TARGET test_ros_unit)
   target_link_libraries(test_ros_unit ${PROJECT_NAME}_ros ${GTEST_MAIN_LIBRARIES})
   target_compile_definitions(test_ros_unit PRIVATE ${LSF_ROS_TEST_DEFINITIONS})
@@ -44,8 +47,13 @@ add_rostest(test/ros/fusion_node.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_approx_sync.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_max_rate.test DEPENDENCIES test_fusion_node)
 
+# Issue 10: depth_image_proc / stereo_image_proc consume the outputs by remapping only; dynparam
+# refusals are visible; silent inputs are named.
+lsf_add_ros_test_node(test_ros_conventions test/ros/test_ros_conventions.cpp test/ros/run_command.cpp)
+add_rostest(test/ros/ros_conventions.test DEPENDENCIES test_ros_conventions)
+
 # RViz with rviz/fusion.rviz under Xvfb: the fused cloud is drawn (screenshots in the build folder).
-lsf_add_ros_test_node(test_rviz_screenshot test/ros/test_rviz_screenshot.cpp)
+lsf_add_ros_test_node(test_rviz_screenshot test/ros/test_rviz_screenshot.cpp test/ros/child_process.cpp)
 add_rostest(test/ros/rviz_screenshot.test DEPENDENCIES test_rviz_screenshot)
 
 # The simulated street as a live rig: demos, the RViz check, latency and rate measurements.

@@ -62,6 +62,14 @@ if(TARGET kitti_runner)
     DEPENDS kitti_to_bag ${PROJECT_NAME}_ros)
   target_compile_definitions(test_kitti_bag_rates PRIVATE
     LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
+  # playback.launch on a KITTI bag: to the end (fusion and RViz stay) and looped (issue 10).
+  lsf_add_tools_rostest(test_playback test/ros/playback.test
+    SOURCES test/ros/test_playback.cpp test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
+            test/ros/child_process.cpp
+    DEPENDS kitti_to_bag fusion_node ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
+  target_include_directories(test_playback SYSTEM PRIVATE
+    ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})  # FusionStats.h
+  target_compile_definitions(test_playback PRIVATE LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
 else()
   message(WARNING "no kitti_runner target (tools/kitti_runner.cpp): test/ros/kitti_bag.test is "
                   "not registered")

@@ -12,6 +12,7 @@ PKGS=(
   libmessage-filters-dev librosbag-dev python3-rosbag
   librostest-dev python3-rostest
   libstereo-msgs-dev ros-stereo-msgs libdiagnostic-updater-dev python3-diagnostic-msgs
+  libdepth-image-proc0d libdepth-image-proc-dev ros-stereo-image-proc libstereo-image-proc-dev
   python3-dynamic-reconfigure libdynamic-reconfigure-config-init-mutex-dev
   libgtest-dev libopencv-dev libeigen3-dev libyaml-cpp-dev
   python3-roslaunch ros-message-generation ros-message-runtime

@@ -26,7 +26,9 @@ export ROS_LOG_DIR=${ROS_LOG_DIR:-$WS/ros_home/log}
 mkdir -p "$WS/src"
 ln -sfn "$ROOT" "$WS/src/lidar_stereo_fusion"
 cd "$WS"
-CMAKE_ARGS=(-DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release "-DLSF_DATA_DIR=$DATA")
+# Both Python variables: Debian's pluginlib looks Python up again with find_package(Python3).
+CMAKE_ARGS=(-DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3
+            -DCMAKE_BUILD_TYPE=Release "-DLSF_DATA_DIR=$DATA")
 
 echo "== build (catkin workspace $WS)"
 catkin_make "${CMAKE_ARGS[@]}" -j"$JOBS" all

@@ -45,7 +45,8 @@ Options:
   --holdout even|none  even: feed the even LiDAR rings only and score against the odd rings'
                        depth (a ground-truth-free accuracy check; excludes --reference)
   --save-vis           also write <out>/vis/<frame>_{sparse,prior,confidence,disparity,depth,
-                       error}.png (confidence of the prior: dark = 0, yellow = 1)
+                       error}.png, each with a colour bar in its unit (depth in metres,
+                       disparity and error in px, confidence 0 .. 1)
   --frames N           process only the first N frames
   --help               this text
 
@@ -131,18 +132,29 @@ void saveVisualisation(const fs::path& dir, const std::string& name, const cv::M
   double max_disparity = 0;
   cv::minMaxLoc(result.sparse.disparity, nullptr, &max_disparity);
   writeImage(dir / (name + "_sparse.png"),
-             lsf::overlaySparse(left, result.sparse.disparity, max_disparity));
+             lsf::withColorBar(lsf::overlaySparse(left, result.sparse.disparity, max_disparity), 0,
+                               max_disparity, "px disparity"));
   if (!result.prior.empty()) {
-    writeImage(dir / (name + "_prior.png"), lsf::colorizeDisparity(result.prior, max_disparity));
+    writeImage(dir / (name + "_prior.png"),
+               lsf::withColorBar(lsf::colorizeDisparity(result.prior, max_disparity), 0,
+                                 max_disparity, "px disparity"));
     writeImage(dir / (name + "_confidence.png"),
-               lsf::colorizeConfidence(result.confidence, result.prior));
+               lsf::withColorBar(lsf::colorizeConfidence(result.confidence, result.prior), 0, 1,
+                                 "confidence", cv::COLORMAP_VIRIDIS));
   }
   writeImage(dir / (name + "_disparity.png"),
-             lsf::colorizeDisparity(result.disparity, max_disparity));
-  writeImage(dir / (name + "_depth.png"), lsf::colorizeDepth(result.depth));
+             lsf::withColorBar(lsf::colorizeDisparity(result.disparity, max_disparity), 0,
+                               max_disparity, "px disparity"));
+  constexpr double kMaxDepth = 80.0;  ///< [m] colorizeDepth's scale
+  writeImage(dir / (name + "_depth.png"),
+             lsf::withColorBar(lsf::colorizeDepth(result.depth, kMaxDepth), kMaxDepth, 0, "m"));
   if (reference) {
-    writeImage(dir / (name + "_error.png"),
-               lsf::colorizeError(result.disparity, lsf::depthToDisparity(*reference, camera)));
+    constexpr double kMaxError = 5.0;  ///< [px] colorizeError's scale
+    writeImage(
+        dir / (name + "_error.png"),
+        lsf::withColorBar(lsf::colorizeError(result.disparity,
+                                             lsf::depthToDisparity(*reference, camera), kMaxError),
+                          0, kMaxError, "px error"));
   }
 }
 

@@ -2,6 +2,7 @@
 #include "lidar_stereo_fusion/core/depth.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -55,36 +56,68 @@ cv::Mat1f depthToDisparity(const cv::Mat1f& depth, const StereoCamera& camera) {
   return disparity;
 }
 
-std::vector<ColoredPoint> makeColoredCloud(const cv::Mat1f& depth, const cv::Mat& image,
-                                           const StereoCamera& camera, int stride) {
-  requireCameraSize(depth, camera, "makeColoredCloud");
+namespace {
+
+void checkCloudInputs(const cv::Mat1f& depth, const cv::Mat& image, const StereoCamera& camera,
+                      int stride, const char* what) {
+  requireCameraSize(depth, camera, what);
   if (image.size() != depth.size()) {
-    throw std::invalid_argument("makeColoredCloud: image is " + std::to_string(image.cols) + "x" +
-                                std::to_string(image.rows) + " but depth is " +
+    throw std::invalid_argument(std::string(what) + ": image is " + std::to_string(image.cols) +
+                                "x" + std::to_string(image.rows) + " but depth is " +
                                 std::to_string(depth.cols) + "x" + std::to_string(depth.rows));
   }
   if (image.type() != CV_8UC3 && image.type() != CV_8UC1) {
-    throw std::invalid_argument("makeColoredCloud: image must be BGR CV_8UC3 or grey CV_8UC1");
+    throw std::invalid_argument(std::string(what) + ": image must be BGR CV_8UC3 or grey CV_8UC1");
   }
-  if (stride < 1) throw std::invalid_argument("makeColoredCloud: stride must be >= 1");
+  if (stride < 1) throw std::invalid_argument(std::string(what) + ": stride must be >= 1");
+}
+
+/// The point of pixel (x, y) at depth z (not checked), coloured from `image`.
+ColoredPoint backProject(int x, int y, float z, const cv::Mat& image, const StereoCamera& camera) {
+  ColoredPoint p;
+  p.x = static_cast<float>((x - camera.cx) * z / camera.fx);
+  p.y = static_cast<float>((y - camera.cy) * z / camera.fy);
+  p.z = z;
+  if (image.type() == CV_8UC3) {
+    const cv::Vec3b bgr = image.at<cv::Vec3b>(y, x);
+    p.b = bgr[0];
+    p.g = bgr[1];
+    p.r = bgr[2];
+  } else {
+    p.r = p.g = p.b = image.at<uint8_t>(y, x);
+  }
+  return p;
+}
+
+}  // namespace
+
+std::vector<ColoredPoint> makeColoredCloud(const cv::Mat1f& depth, const cv::Mat& image,
+                                           const StereoCamera& camera, int stride) {
+  checkCloudInputs(depth, image, camera, stride, "makeColoredCloud");
   std::vector<ColoredPoint> cloud;
   for (int y = 0; y < depth.rows; y += stride) {
     for (int x = 0; x < depth.cols; x += stride) {
       const float z = depth(y, x);
-      if (!hasValue(z)) continue;
-      ColoredPoint p;
-      p.x = static_cast<float>((x - camera.cx) * z / camera.fx);
-      p.y = static_cast<float>((y - camera.cy) * z / camera.fy);
-      p.z = z;
-      if (image.type() == CV_8UC3) {
-        const cv::Vec3b bgr = image.at<cv::Vec3b>(y, x);
-        p.b = bgr[0];
-        p.g = bgr[1];
-        p.r = bgr[2];
-      } else {
-        p.r = p.g = p.b = image.at<uint8_t>(y, x);
-      }
-      cloud.push_back(p);
+      if (hasValue(z)) cloud.push_back(backProject(x, y, z, image, camera));
+    }
+  }
+  return cloud;
+}
+
+OrganizedCloud makeOrganizedCloud(const cv::Mat1f& depth, const cv::Mat& image,
+                                  const StereoCamera& camera, int stride) {
+  checkCloudInputs(depth, image, camera, stride, "makeOrganizedCloud");
+  OrganizedCloud cloud;
+  cloud.width = (depth.cols + stride - 1) / stride;
+  cloud.height = (depth.rows + stride - 1) / stride;
+  cloud.points.reserve(static_cast<size_t>(cloud.width) * cloud.height);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int y = 0; y < depth.rows; y += stride) {
+    for (int x = 0; x < depth.cols; x += stride) {
+      const float z = depth(y, x);
+      ColoredPoint p = backProject(x, y, hasValue(z) ? z : 1.f, image, camera);
+      if (!hasValue(z)) p.x = p.y = p.z = nan;
+      cloud.points.push_back(p);
     }
   }
   return cloud;

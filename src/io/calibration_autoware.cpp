@@ -17,11 +17,12 @@ namespace {
 
 /// Throws std::runtime_error naming the line when `text` is not laid out as the calibrator writes
 /// it: the %YAML directive, "---", "Key: value" lines at column 0 and indented continuation lines
-/// (matrix fields, wrapped data), blank lines and comments. OpenCV's YAML parser can loop forever
-/// on some malformed input (found by fuzzing: a bare "5, -1," line before "---at:"), so files of
-/// another shape never reach it.
+/// (matrix fields, wrapped data) below a key, blank lines and comments. OpenCV's YAML parser can
+/// loop forever on some malformed input (found by fuzzing: a bare "5, -1," line before "---at:";
+/// indented lines before any key), so files of another shape never reach it.
 void requireAutowareLayout(const std::string& text, const std::string& path) {
   std::size_t start = 0;
+  bool seen_key = false;
   for (int number = 1; start <= text.size(); ++number) {
     std::size_t end = text.find('\n', start);
     if (end == std::string::npos) end = text.size();
@@ -30,9 +31,14 @@ void requireAutowareLayout(const std::string& text, const std::string& path) {
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) {
       line.pop_back();
     }
-    if (line.empty() || line[0] == '#' || line[0] == ' ' || line[0] == '\t' || line == "---" ||
+    if (line.empty() || line[0] == '#' || line == "---" ||
         ((line == "%YAML:1.0" || line == "%YAML 1.0") && number == 1)) {
       continue;
+    }
+    if (line[0] == ' ' || line[0] == '\t') {
+      if (seen_key) continue;  // a continuation of the key above
+      throw std::runtime_error("Autoware calibration " + path + ": line " + std::to_string(number) +
+                               " is indented but no 'Key: value' line comes before it");
     }
     std::size_t key_end = 0;
     while (key_end < line.size() &&
@@ -46,6 +52,7 @@ void requireAutowareLayout(const std::string& text, const std::string& path) {
       throw std::runtime_error("Autoware calibration " + path + ": line " + std::to_string(number) +
                                " is not 'Key: value' (" + line.substr(0, 40) + ")");
     }
+    seen_key = true;
   }
 }
 

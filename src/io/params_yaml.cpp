@@ -1,110 +1,25 @@
 // FusionParams <-> YAML. Reading uses OpenCV FileStorage; writing emits plain YAML (no OpenCV
 // "%YAML:1.0" directive) so that rosparam can load the same file.
 //
-// Every field is listed once, in the visit*() functions below; reading, the unknown-key check and
-// writing all walk those lists, so a field added there is supported everywhere.
+// The keys are the names of io/param_table.h, at the top level (one name per parameter, as in
+// rosparam and dynamic_reconfigure). The previous layout, the same names in sections
+// (`patchmatch: {window_radius: 5}`), is still read.
 #include "lidar_stereo_fusion/io/params_yaml.h"
 
+#include "lidar_stereo_fusion/io/param_table.h"
 #include "lidar_stereo_fusion/io/text_file.h"
 
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
 namespace lidar_stereo_fusion {
 namespace {
-
-// ---- The field lists ------------------------------------------------------------------------
-
-template <class P, class V>
-void visitProjection(P& p, V& v) {
-  v("min_depth", p.min_depth);
-  v("max_depth", p.max_depth);
-}
-
-template <class P, class V>
-void visitBI(P& p, V& v) {
-  v("max_gap_px", p.max_gap_px);
-  v("max_jump_disp", p.max_jump_disp);
-  v("max_disp_diff", p.max_disp_diff);
-  v("max_color_diff", p.max_color_diff);
-  v("search_lines", p.search_lines);
-  v("max_interp_rows", p.max_interp_rows);
-}
-
-template <class P, class V>
-void visitBF(P& p, V& v) {
-  v("radius", p.radius);
-  v("sigma_space", p.sigma_space);
-  v("sigma_range", p.sigma_range);
-  v("min_support", p.min_support);
-}
-
-template <class P, class V>
-void visitConfidence(P& p, V& v) {
-  v("edge_tolerance", p.edge_tolerance);
-  v("edge_sigma", p.edge_sigma);
-  v("max_surface_slope", p.max_surface_slope);
-  v("removed_factor", p.removed_factor);
-  v("near_rows", p.near_rows);
-  v("decay_rows", p.decay_rows);
-  v("hole_confidence", p.hole_confidence);
-}
-
-template <class P, class V>
-void visitPatchMatch(P& p, V& v) {
-  v("window_radius", p.window_radius);
-  v("window_stride", p.window_stride);
-  v("window_dyadic", p.window_dyadic);
-  v("weight_delta", p.weight_delta);
-  v("alpha", p.alpha);
-  v("beta", p.beta);
-  v("gamma", p.gamma);
-  v("lambda_col", p.lambda_col);
-  v("lambda_grad", p.lambda_grad);
-  v("lambda_disp", p.lambda_disp);
-  v("iterations", p.iterations);
-  v("right_iterations", p.right_iterations);
-  v("slanted", p.slanted);
-  v("init_from_prior", p.init_from_prior);
-  v("init_normal_from_prior", p.init_normal_from_prior);
-  v("use_lidar_bounds", p.use_lidar_bounds);
-  v("bound_margin", p.bound_margin);
-  v("min_refine_range", p.min_refine_range);
-  v("min_disparity", p.min_disparity);
-  v("max_disparity", p.max_disparity);
-  v("view_propagation", p.view_propagation);
-  v("lr_check", p.lr_check);
-  v("lr_max_diff", p.lr_max_diff);
-  v("median_radius", p.median_radius);
-  v("confidence_weighting", p.confidence_weighting);
-  v("lock_confidence", p.lock_confidence);
-  v("fill_confidence", p.fill_confidence);
-  v("coarse_scale", p.coarse_scale);
-  v("coarse_levels", p.coarse_levels);
-  v("full_size_unbounded", p.full_size_unbounded);
-  v("fine_iterations", p.fine_iterations);
-  v("fine_refine_range", p.fine_refine_range);
-  v("fine_right_view", p.fine_right_view);
-  v("fine_subpixel", p.fine_subpixel);
-  v("num_threads", p.num_threads);
-  v("seed", p.seed);
-}
-
-/// Calls `section(name, visit_fields)` for every section of FusionParams.
-template <class F, class S>
-void visitSections(F& params, S& section) {
-  section("projection", [&](auto& v) { visitProjection(params.projection, v); });
-  section("bi", [&](auto& v) { visitBI(params.bi, v); });
-  section("bf", [&](auto& v) { visitBF(params.bf, v); });
-  section("confidence", [&](auto& v) { visitConfidence(params.confidence, v); });
-  section("patchmatch", [&](auto& v) { visitPatchMatch(params.patchmatch, v); });
-}
 
 // ---- Reading --------------------------------------------------------------------------------
 
@@ -127,34 +42,39 @@ std::string lower(std::string s) {
   return s;
 }
 
-/// Reads scalar values of one section, with errors naming file and key.
+/// Reads the values present in the file, with errors naming file and key. A key is looked up at
+/// the top level and, as the deprecated layout, in its group's section.
 class FieldReader {
  public:
-  FieldReader(const cv::FileNode& section, std::string where)
-      : section_(section), where_(std::move(where)) {}
+  FieldReader(const cv::FileNode& root, std::string path) : root_(root), path_(std::move(path)) {}
 
   template <class T>
-  void operator()(const std::string& key, T& value) {
-    known_.insert(key);
-    const cv::FileNode node = section_[key];
-    if (!node.empty()) read(node, key, value);
-  }
-
-  /// Throws when the section has a key that no field claimed.
-  void rejectUnknownKeys() const {
-    for (const cv::FileNode& node : section_) {
-      if (known_.count(node.name()) == 0) {
-        std::string valid;
-        for (const std::string& k : known_) valid += (valid.empty() ? "" : ", ") + k;
-        throw std::runtime_error(where_ + ": unknown key '" + node.name() + "' (valid: " + valid +
-                                 ")");
-      }
+  void operator()(const ParamName& n, T& value) {
+    const cv::FileNode top = root_[n.name];
+    cv::FileNode grouped;
+    if (*n.group != '\0') {
+      const cv::FileNode section = root_[n.group];
+      if (!section.empty() && section.isMap()) grouped = section[n.name];
     }
+    if (!top.empty() && !grouped.empty()) {
+      fail(n.name, std::string("is given twice (top level and in section '") + n.group + "')");
+    }
+    const cv::FileNode& node = top.empty() ? grouped : top;
+    if (!node.empty()) read(node, n.name, value);
   }
 
  private:
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw std::runtime_error(where_ + ": key '" + key + "' " + what);
+    throw std::runtime_error("params YAML " + path_ + ": key '" + key + "' " + what);
+  }
+
+  void read(const cv::FileNode& node, const std::string& key, Method& value) const {
+    if (!node.isString()) fail(key, "must be a name");
+    try {
+      value = parseMethod(scalarString(node));
+    } catch (const std::invalid_argument& e) {
+      fail(key, e.what());
+    }
   }
 
   void read(const cv::FileNode& node, const std::string& key, double& value) const {
@@ -207,10 +127,43 @@ class FieldReader {
     }
   }
 
-  cv::FileNode section_;
-  std::string where_;
-  std::set<std::string> known_;
+  cv::FileNode root_;
+  std::string path_;
 };
+
+/// Throws on a key that is neither a parameter nor a (deprecated) section holding only the
+/// parameters of its group.
+void rejectUnknownKeys(const cv::FileNode& root, const std::string& path) {
+  std::set<std::string> names;
+  std::map<std::string, std::set<std::string>> groups;
+  for (const ParamInfo& p : paramTable()) {
+    names.insert(p.name);
+    if (!p.group.empty()) groups[p.group].insert(p.name);
+  }
+  const auto list = [](const std::set<std::string>& keys) {
+    std::string out;
+    for (const std::string& k : keys) out += (out.empty() ? "" : ", ") + k;
+    return out;
+  };
+  for (const cv::FileNode& node : root) {
+    const std::string key = node.name();
+    if (names.count(key)) continue;
+    const auto group = groups.find(key);
+    if (group == groups.end()) {
+      throw std::runtime_error("params YAML " + path + ": unknown key '" + key +
+                               "' (valid: " + list(names) + ")");
+    }
+    if (!node.isMap()) {
+      throw std::runtime_error("params YAML " + path + ": '" + key + "' must be a map");
+    }
+    for (const cv::FileNode& field : node) {
+      if (!group->second.count(field.name())) {
+        throw std::runtime_error("params YAML " + path + " section '" + key + "': unknown key '" +
+                                 field.name() + "' (valid: " + list(group->second) + ")");
+      }
+    }
+  }
+}
 
 /// OpenCV's YAML reader needs a "%YAML" directive; rosparam files have none.
 std::string withYamlDirective(const std::string& text) {
@@ -234,43 +187,28 @@ cv::FileStorage openYaml(const std::string& path) {
   return fs;
 }
 
-void readMethod(const cv::FileNode& node, const std::string& path, Method& method) {
-  if (!node.isString())
-    throw std::runtime_error("params YAML " + path + ": key 'method' must be a name");
-  try {
-    method = parseMethod(scalarString(node));
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error("params YAML " + path + ": key 'method': " + e.what());
-  }
-}
-
 // ---- Writing --------------------------------------------------------------------------------
-
-std::string formatDouble(double v) {
-  char buf[64];
-  // Shortest text that reads back to the same double ("200", "0.1").
-  const auto result = std::to_chars(buf, buf + sizeof(buf), v);
-  std::string s(buf, result.ptr);
-  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";  // keep it a real number
-  return s;
-}
 
 class FieldWriter {
  public:
   explicit FieldWriter(std::ostream& out) : out_(out) {}
-  void operator()(const std::string& key, double v) { line(key, formatDouble(v)); }
-  void operator()(const std::string& key, int v) { line(key, std::to_string(v)); }
-  void operator()(const std::string& key, bool v) { line(key, v ? "true" : "false"); }
-  void operator()(const std::string& key, uint64_t v) {
+  void operator()(const ParamName& n, Method v) { line(n, methodName(v)); }
+  void operator()(const ParamName& n, double v) { line(n, formatParamDouble(v)); }
+  void operator()(const ParamName& n, int v) { line(n, std::to_string(v)); }
+  void operator()(const ParamName& n, bool v) { line(n, v ? "true" : "false"); }
+  void operator()(const ParamName& n, uint64_t v) {
     const bool fits = v <= static_cast<uint64_t>(std::numeric_limits<int>::max());
-    line(key, fits ? std::to_string(v) : "\"" + std::to_string(v) + "\"");
+    line(n, fits ? std::to_string(v) : "\"" + std::to_string(v) + "\"");
   }
 
  private:
-  void line(const std::string& key, const std::string& value) {
-    out_ << "  " << key << ": " << value << "\n";
+  void line(const ParamName& n, const std::string& value) {
+    if (group_ != n.group && *n.group != '\0') out_ << "# " << n.group << "\n";
+    group_ = n.group;
+    out_ << n.name << ": " << value << "\n";
   }
   std::ostream& out_;
+  std::string group_;
 };
 
 }  // namespace
@@ -279,28 +217,10 @@ void loadParamsYaml(const std::string& path, FusionParams& params) {
   cv::FileStorage fs = openYaml(path);
   const cv::FileNode root = fs.root();
   FusionParams loaded = params;
-  std::set<std::string> sections = {"method"};
   if (!root.empty() && !root.isNone()) {
     if (!root.isMap()) throw std::runtime_error("params YAML " + path + ": top level is not a map");
-    auto section = [&](const std::string& name, auto visit_fields) {
-      sections.insert(name);
-      const cv::FileNode node = root[name];
-      if (node.empty()) return;
-      if (!node.isMap()) {
-        throw std::runtime_error("params YAML " + path + ": '" + name + "' must be a map");
-      }
-      FieldReader reader(node, "params YAML " + path + " section '" + name + "'");
-      visit_fields(reader);
-      reader.rejectUnknownKeys();
-    };
-    visitSections(loaded, section);
-    if (!root["method"].empty()) readMethod(root["method"], path, loaded.method);
-    for (const cv::FileNode& node : root) {
-      if (sections.count(node.name()) == 0) {
-        throw std::runtime_error("params YAML " + path + ": unknown key '" + node.name() +
-                                 "' (valid: method, projection, bi, bf, patchmatch)");
-      }
-    }
+    rejectUnknownKeys(root, path);
+    visitParamTable(loaded, FieldReader(root, path));
   }
   try {
     loaded.validate();
@@ -312,14 +232,8 @@ void loadParamsYaml(const std::string& path, FusionParams& params) {
 
 void saveParamsYaml(const std::string& path, const FusionParams& params) {
   std::ostringstream out;
-  out << "# lidar_stereo_fusion parameters (every field; see include/lidar_stereo_fusion/core)\n";
-  out << "method: " << methodName(params.method) << "\n";
-  FieldWriter writer(out);
-  auto section = [&](const std::string& name, auto visit_fields) {
-    out << name << ":\n";
-    visit_fields(writer);
-  };
-  visitSections(params, section);
+  out << "# lidar_stereo_fusion parameters (every field; names: io/param_table.h)\n";
+  visitParamTable(params, FieldWriter(out));
   std::ofstream file(path);
   if (!file) throw std::runtime_error("params YAML: cannot create " + path);
   file << out.str();

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -105,6 +106,38 @@ cv::Mat colorizeError(const cv::Mat1f& estimate, const cv::Mat1f& reference, dou
     }
   }
   return colorize(level, mask);
+}
+
+cv::Mat withColorBar(const cv::Mat& picture, double value_at_0, double value_at_255,
+                     const std::string& unit, int colormap) {
+  requireNonEmpty(picture, "withColorBar");
+  if (picture.type() != CV_8UC3) throw std::invalid_argument("withColorBar: picture must be BGR8");
+  // Sized for the picture: readable on a 1242-wide KITTI frame and on a 320-wide test image.
+  const int width = picture.cols, margin = std::max(8, width / 40);
+  const double font = std::clamp(width / 1400.0, 0.3, 0.8);
+  const int bar_height = std::max(8, width / 60), text_height = static_cast<int>(28 * font) + 6;
+  cv::Mat out(picture.rows + bar_height + text_height + 6, width, CV_8UC3, cv::Scalar::all(0));
+  picture.copyTo(out(cv::Rect(0, 0, width, picture.rows)));
+  const int bar_width = width - 2 * margin, top = picture.rows + 3;
+  if (bar_width < 2) return out;
+  cv::Mat1b levels(1, bar_width);
+  for (int x = 0; x < bar_width; ++x) levels(0, x) = toLevel(x / (bar_width - 1.0));
+  cv::Mat bar;
+  cv::applyColorMap(levels, bar, colormap);
+  cv::resize(bar, bar, cv::Size(bar_width, bar_height), 0, 0, cv::INTER_NEAREST);
+  bar.copyTo(out(cv::Rect(margin, top, bar_width, bar_height)));
+  for (int k = 0; k <= 4; ++k) {
+    const double f = k / 4.0, value = value_at_0 + f * (value_at_255 - value_at_0);
+    char text[64];
+    std::snprintf(text, sizeof(text), "%.3g%s%s", value, unit.empty() ? "" : " ", unit.c_str());
+    int baseline = 0;
+    const cv::Size size = cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, font, 1, &baseline);
+    const int x = std::clamp(margin + static_cast<int>(f * (bar_width - 1)) - size.width / 2, 0,
+                             std::max(0, width - size.width));
+    cv::putText(out, text, cv::Point(x, top + bar_height + size.height + 3),
+                cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar::all(230), 1, cv::LINE_AA);
+  }
+  return out;
 }
 
 cv::Mat overlaySparse(const cv::Mat& image, const cv::Mat1f& sparse, double max_disparity) {

@@ -390,28 +390,28 @@ stereo_msgs::DisparityImagePtr disparityToMsg(const cv::Mat1f& disparity,
   msg->image = floatImage(disparity, header);
   msg->f = static_cast<float>(camera.fx);
   msg->T = static_cast<float>(camera.baseline);
-  // Valid values are > 0; the range is the search range widened to what the map holds, so that
-  // every valid value is within [min_disparity, max_disparity] and 0 (no value) is below it.
-  double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
+  // The configured search range, as stereo_image_proc (not the values of this frame). Values
+  // outside it (LiDAR-only methods: very far or very near points) are published as 0 = no value,
+  // which is below min_disparity as long as the range starts above 0.
+  const double min_d = min_search > 0.0 ? min_search : 1.0;
+  const double max_d = std::max(max_search, min_d);
+  float* data = reinterpret_cast<float*>(msg->image.data.data());
   int left = disparity.cols, top = disparity.rows, right = -1, bottom = -1;
   for (int r = 0; r < disparity.rows; ++r) {
-    const float* row = disparity.ptr<float>(r);
+    float* row = data + static_cast<size_t>(r) * disparity.cols;
     for (int c = 0; c < disparity.cols; ++c) {
       const float d = row[c];
-      if (!(d > 0.f) || !std::isfinite(d)) continue;
-      lo = std::min(lo, static_cast<double>(d));
-      hi = std::max(hi, static_cast<double>(d));
+      if (!(d >= min_d && d <= max_d)) {  // also NaN and 0
+        row[c] = 0.f;
+        continue;
+      }
       left = std::min(left, c);
       right = std::max(right, c);
       top = std::min(top, r);
       bottom = std::max(bottom, r);
     }
   }
-  double min_d = min_search > 0.0 ? min_search : 1.0;
-  double max_d = std::max(max_search, min_d);
   if (right >= 0) {
-    min_d = std::min(min_d, lo);
-    max_d = std::max(max_d, hi);
     msg->valid_window.x_offset = static_cast<uint32_t>(left);
     msg->valid_window.y_offset = static_cast<uint32_t>(top);
     msg->valid_window.width = static_cast<uint32_t>(right - left + 1);
@@ -439,21 +439,31 @@ sensor_msgs::ImagePtr depthToMsg(const cv::Mat1f& depth, const std_msgs::Header&
   return msg;
 }
 
+sensor_msgs::ImagePtr bgrImageToMsg(const cv::Mat& image, const std_msgs::Header& header) {
+  if (image.type() != CV_8UC3) throw ConversionError("bgrImageToMsg: image must be CV_8UC3");
+  return cv_bridge::CvImage(header, sensor_msgs::image_encodings::BGR8, image).toImageMsg();
+}
+
 sensor_msgs::ImagePtr floatImageToMsg(const cv::Mat1f& image, const std_msgs::Header& header) {
   return boost::make_shared<sensor_msgs::Image>(floatImage(image, header));
 }
 
-sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const std::vector<ColoredPoint>& points,
+sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const OrganizedCloud& cloud,
                                               const std_msgs::Header& header) {
   auto msg = boost::make_shared<sensor_msgs::PointCloud2>();
   msg->header = header;
   sensor_msgs::PointCloud2Modifier modifier(*msg);
   modifier.setPointCloud2Fields(4, "x", 1, PointField::FLOAT32, "y", 1, PointField::FLOAT32, "z", 1,
                                 PointField::FLOAT32, "rgb", 1, PointField::FLOAT32);
-  modifier.resize(points.size());
+  // resize(w * h) makes it 1 x N; the organised shape is set after.
+  modifier.resize(cloud.points.size());
+  msg->height = static_cast<uint32_t>(cloud.height);
+  msg->width = static_cast<uint32_t>(cloud.width);
+  msg->row_step = msg->width * msg->point_step;
   sensor_msgs::PointCloud2Iterator<float> x(*msg, "x"), y(*msg, "y"), z(*msg, "z");
   sensor_msgs::PointCloud2Iterator<uint8_t> rgb(*msg, "rgb");  // bytes b, g, r, a (little endian)
-  for (const auto& p : points) {
+  bool dense = true;
+  for (const auto& p : cloud.points) {
     *x = p.x;
     *y = p.y;
     *z = p.z;
@@ -461,9 +471,10 @@ sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const std::vector<ColoredPoint>& p
     rgb[1] = p.g;
     rgb[2] = p.r;
     rgb[3] = 0;
+    dense = dense && std::isfinite(p.z);
     ++x, ++y, ++z, ++rgb;
   }
-  msg->is_dense = true;
+  msg->is_dense = dense;
   return msg;
 }
 

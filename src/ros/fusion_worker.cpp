@@ -62,6 +62,10 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
   worker_ = std::thread(&FusionWorker::workerLoop, this);
   outputs_.advertise();  // last: connect callbacks may subscribe right away
 
+  std::string drivers;  // set by launch files that start drivers (zed_vls128.launch)
+  if (pnh_.getParam("drivers", drivers) && !drivers.empty()) {
+    ROS_INFO_STREAM("[" << name_ << "] drivers: " << drivers);
+  }
   ROS_INFO_STREAM("[" << name_ << "] method " << methodName(params_.method) << ", "
                       << (node_params_.approximate_sync ? "approximate" : "exact")
                       << " image sync, sweeps matched within " << node_params_.max_time_offset
@@ -85,10 +89,11 @@ void FusionWorker::reconfigureCb(FusionConfig& config, uint32_t /*level*/) {
     candidate = ros_params::fromConfig(config);
     candidate.validate();
   } catch (const std::exception& e) {
-    std::string changes = ros_params::describeChanges(current, candidate);
-    ROS_ERROR_STREAM("[" << name_ << "] rejected parameter change (" << changes << "): " << e.what()
-                         << "; keeping the previous parameters");
-    config = ros_params::toConfig(current);  // the server publishes the values in use
+    // Refused as a whole: the response (and `dynparam get`) carry the values in force.
+    const std::string asked = ros_params::describeRequest(current, config);
+    config = ros_params::toConfig(current);
+    ROS_ERROR_STREAM("[" << name_ << "] parameter change refused: " << e.what() << "; asked "
+                         << asked << "; every parameter keeps the value in force");
     return;
   }
   const std::string changes = ros_params::describeChanges(current, candidate);

@@ -71,7 +71,15 @@ bool RateLimiter::accept(const ros::Time& stamp) {
 
 InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
                      const NodeParams& params, Counters& counters, ThrottledLog& log)
-    : nh_(nh), pnh_(pnh), params_(params), counters_(counters), log_(log), rate_(params.max_rate) {
+    : nh_(nh),
+      pnh_(pnh),
+      params_(params),
+      counters_(counters),
+      log_(log),
+      watch_({topicName(kLeftImage), topicName(kLeftInfo), topicName(kRightImage),
+              topicName(kRightInfo), topicName(kCloud)},
+             params.input_timeout, log),
+      rate_(params.max_rate) {
   InputMatcher::Params mp;
   mp.max_time_offset = params_.max_time_offset;
   mp.max_wait = params_.max_sweep_wait;
@@ -98,6 +106,34 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
     exact_sync_->registerCallback(boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4));
     exact_sync_->registerDropCallback(boost::bind(&InputGate::syncDropCb, this, _1, _2, _3, _4));
   }
+  // Every input topic's arrivals, for the watch (indices as in watch_'s list); the cloud's in
+  // cloudCb.
+  sub_left_image_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
+      [this](const auto&) { watch_.heard(0); }));
+  sub_left_info_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
+      [this](const auto&) { watch_.heard(1); }));
+  sub_right_image_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
+      [this](const auto&) { watch_.heard(2); }));
+  sub_right_info_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
+      [this](const auto&) { watch_.heard(3); }));
+  if (params_.input_timeout > 0.0) {
+    watch_timer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
+      watch_.check([this](std::size_t i) -> uint32_t {
+        switch (i) {
+          case 0:
+            return sub_left_image_.getSubscriber().getNumPublishers();
+          case 1:
+            return sub_left_info_.getSubscriber().getNumPublishers();
+          case 2:
+            return sub_right_image_.getSubscriber().getNumPublishers();
+          case 3:
+            return sub_right_info_.getSubscriber().getNumPublishers();
+          default:
+            return sub_cloud_.getNumPublishers();
+        }
+      });
+    });
+  }
 }
 
 InputGate::~InputGate() {
@@ -114,10 +150,12 @@ void InputGate::subscribe() {
   sub_right_info_.subscribe(nh_, kRightInfo, q);
   sub_cloud_ = nh_.subscribe(kCloud, 2, &InputGate::cloudCb, this);
   subscribed_ = true;
+  watch_.start();
   ROS_DEBUG_STREAM("[" << log_.name() << "] subscribed to the inputs");
 }
 
 void InputGate::unsubscribe() {
+  watch_.stop();
   sub_left_image_.unsubscribe();
   sub_left_info_.unsubscribe();
   sub_right_image_.unsubscribe();
@@ -230,6 +268,7 @@ void InputGate::syncDropCb(const sensor_msgs::ImageConstPtr& left,
 }
 
 void InputGate::cloudCb(const sensor_msgs::PointCloud2ConstPtr& cloud) {
+  watch_.heard(4);
   const ros::Time stamp = cloud->header.stamp;
   ROS_DEBUG_STREAM("[" << log_.name() << "] sweep " << stampText(stamp) << " ("
                        << static_cast<uint64_t>(cloud->width) * cloud->height << " points)");

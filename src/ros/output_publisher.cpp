@@ -6,6 +6,7 @@
 #include <boost/make_shared.hpp>
 
 #include "lidar_stereo_fusion/core/depth.h"
+#include "lidar_stereo_fusion/io/visualization.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
 
 namespace lidar_stereo_fusion {
@@ -80,8 +81,10 @@ OutputPublisher::OutputPublisher(const ros::NodeHandle& nh, const ros::NodeHandl
   updater_.setHardwareID("none");
   updater_.add("output", this, &OutputPublisher::diagnoseOutput);
   updater_.add("processing", this, &OutputPublisher::diagnoseProcessing);
-  diag_timer_ =
-      nh_.createTimer(ros::Duration(0.5), [this](const ros::TimerEvent&) { updater_.update(); });
+  // A wall-clock timer and force_update(): Updater::update() and ROS timers wait for ROS time to
+  // pass the next period, which after a bag loop (simulated time jumps back) takes a whole loop.
+  diag_timer_ = nh_.createWallTimer(
+      ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { updater_.force_update(); });
 }
 
 OutputPublisher::~OutputPublisher() { shutdown(); }
@@ -97,8 +100,9 @@ void OutputPublisher::advertise() {
   pub_disparity_ = nh_.advertise<stereo_msgs::DisparityImage>("disparity", 1, ros_cb, ros_cb);
   pub_points_ = nh_.advertise<sensor_msgs::PointCloud2>("points2", 1, ros_cb, ros_cb);
   pub_stats_ = nh_.advertise<FusionStats>("stats", 10, ros_cb, ros_cb);
-  pub_depth_ = it_->advertise("depth", 1, it_cb, it_cb);
-  pub_depth_info_ = nh_.advertise<sensor_msgs::CameraInfo>("depth/camera_info", 1, ros_cb, ros_cb);
+  // depth/image_rect + depth/camera_info, as depth_image_proc and image_transport pair them.
+  pub_depth_ = it_->advertiseCamera("depth/image_rect", 1, it_cb, it_cb, ros_cb, ros_cb);
+  pub_depth_color_ = it_->advertise("depth/image_color", 1, it_cb, it_cb);
   pub_lidar_disparity_ = it_->advertise("lidar_disparity", 1, it_cb, it_cb);
   pub_disparity_image_ = it_->advertise("disparity_image", 1, it_cb, it_cb);
   pub_confidence_ = it_->advertise("confidence", 1, it_cb, it_cb);
@@ -117,7 +121,7 @@ void OutputPublisher::connectCb() {
   const uint32_t subscribers =
       pub_disparity_.getNumSubscribers() + pub_points_.getNumSubscribers() +
       pub_stats_.getNumSubscribers() + pub_depth_.getNumSubscribers() +
-      pub_depth_info_.getNumSubscribers() + pub_lidar_disparity_.getNumSubscribers() +
+      pub_depth_color_.getNumSubscribers() + pub_lidar_disparity_.getNumSubscribers() +
       pub_disparity_image_.getNumSubscribers() + pub_confidence_.getNumSubscribers();
   if (subscribers == 0 && gate_.subscribed()) {
     gate_.unsubscribe();
@@ -136,7 +140,7 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
     depth = disparityToDepth(result.disparity, camera);
 
   stereo_msgs::DisparityImagePtr disparity_msg;
-  sensor_msgs::ImagePtr depth_msg, prior_msg, disparity_image_msg, confidence_msg;
+  sensor_msgs::ImagePtr depth_msg, depth_color_msg, prior_msg, disparity_image_msg, confidence_msg;
   sensor_msgs::CameraInfoPtr depth_info;
   sensor_msgs::PointCloud2Ptr points_msg;
   if (pub_disparity_.getNumSubscribers() > 0) {
@@ -147,12 +151,22 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
   if (pub_disparity_image_.getNumSubscribers() > 0) {
     disparity_image_msg = conversions::floatImageToMsg(result.disparity, header);
   }
-  if (pub_depth_.getNumSubscribers() > 0) {
-    depth_msg = conversions::depthToMsg(depth, header, params_.max_output_depth);
+  // One depth range for depth/image_rect and points2: the pipeline's (projection max_depth),
+  // clipped further by ~max_output_depth.
+  if (params_.max_output_depth > 0.0) {
+    depth = depth.clone();
+    depth.setTo(0.f, depth > params_.max_output_depth);
   }
-  if (pub_depth_info_.getNumSubscribers() > 0) {
+  if (pub_depth_.getNumSubscribers() > 0) {
+    depth_msg = conversions::depthToMsg(depth, header);
     depth_info = boost::make_shared<sensor_msgs::CameraInfo>(*match.images.left_info);
     depth_info->header = header;
+  }
+  if (pub_depth_color_.getNumSubscribers() > 0) {
+    // For RViz's Image display: colours with a scale bar in metres (a grey 32FC1 has no legend).
+    const double max = params_.depth_color_max;
+    depth_color_msg =
+        conversions::bgrImageToMsg(withColorBar(colorizeDepth(depth, max), max, 0.0, "m"), header);
   }
   if (pub_lidar_disparity_.getNumSubscribers() > 0) {
     const cv::Mat1f prior =
@@ -167,21 +181,16 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
     confidence_msg = conversions::floatImageToMsg(confidence, header);
   }
   if (pub_points_.getNumSubscribers() > 0) {
-    cv::Mat1f clipped = depth;
-    if (params_.max_output_depth > 0.0) {
-      clipped = depth.clone();
-      clipped.setTo(0.f, depth > params_.max_output_depth);
-    }
     points_msg = conversions::coloredCloudToMsg(
-        makeColoredCloud(clipped, left_image, camera, params_.cloud_stride), header);
+        makeOrganizedCloud(depth, left_image, camera, params_.cloud_stride), header);
   }
   const double total_conversion_ms = report.conversion_ms + msSince(out_start);
 
   // Publish everything as close together as possible.
   const ros::Time publish_time = ros::Time::now();
   if (disparity_msg) pub_disparity_.publish(disparity_msg);
-  if (depth_msg) pub_depth_.publish(depth_msg);
-  if (depth_info) pub_depth_info_.publish(depth_info);
+  if (depth_msg) pub_depth_.publish(depth_msg, depth_info);
+  if (depth_color_msg) pub_depth_color_.publish(depth_color_msg);
   if (disparity_image_msg) pub_disparity_image_.publish(disparity_image_msg);
   if (prior_msg) pub_lidar_disparity_.publish(prior_msg);
   if (confidence_msg) pub_confidence_.publish(confidence_msg);
@@ -209,6 +218,12 @@ void OutputPublisher::diagnoseOutput(diagnostic_updater::DiagnosticStatusWrapper
   if (!gate_.subscribed()) {
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "idle: no subscriber on any output");
     return;
+  }
+  // FrequencyStatus measures its window in ROS time: start it again when time restarted (a loop).
+  const uint32_t epoch = gate_.clockEpoch();
+  if (epoch != diag_clock_epoch_) {
+    diag_clock_epoch_ = epoch;
+    output_frequency_.clear();
   }
   output_frequency_.run(stat);
   diagnostic_updater::DiagnosticStatusWrapper stamps;

@@ -1,5 +1,8 @@
 #include "lidar_stereo_fusion/ros/ros_params.h"
 
+#include "lidar_stereo_fusion/io/param_table.h"
+
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <set>
@@ -15,161 +18,96 @@ namespace ros_params {
 
 namespace {
 
-constexpr int kMaxThreads = 256;  ///< as cfg/Fusion.cfg and PatchMatchParams::validate()
+constexpr int kMaxThreads = 256;  ///< as PatchMatchParams::validate()
 
-/// Calls v(group, field, value&) for every field of FusionParams, in declaration order. The value
-/// types are double, int, bool, Method and uint64_t (the seed). This table is the only place that
-/// lists the fields; the names are those of io/params_yaml.h.
-template <class Visitor>
-void visitParams(FusionParams& p, Visitor&& v) {
-  v("", "method", p.method);
-  v("projection", "min_depth", p.projection.min_depth);
-  v("projection", "max_depth", p.projection.max_depth);
-  v("bi", "max_gap_px", p.bi.max_gap_px);
-  v("bi", "max_jump_disp", p.bi.max_jump_disp);
-  v("bi", "max_disp_diff", p.bi.max_disp_diff);
-  v("bi", "max_color_diff", p.bi.max_color_diff);
-  v("bi", "search_lines", p.bi.search_lines);
-  v("bi", "max_interp_rows", p.bi.max_interp_rows);
-  v("bf", "radius", p.bf.radius);
-  v("bf", "sigma_space", p.bf.sigma_space);
-  v("bf", "sigma_range", p.bf.sigma_range);
-  v("bf", "min_support", p.bf.min_support);
-  v("confidence", "edge_tolerance", p.confidence.edge_tolerance);
-  v("confidence", "edge_sigma", p.confidence.edge_sigma);
-  v("confidence", "max_surface_slope", p.confidence.max_surface_slope);
-  v("confidence", "removed_factor", p.confidence.removed_factor);
-  v("confidence", "near_rows", p.confidence.near_rows);
-  v("confidence", "decay_rows", p.confidence.decay_rows);
-  v("confidence", "hole_confidence", p.confidence.hole_confidence);
-  PatchMatchParams& m = p.patchmatch;
-  v("patchmatch", "window_radius", m.window_radius);
-  v("patchmatch", "window_stride", m.window_stride);
-  v("patchmatch", "window_dyadic", m.window_dyadic);
-  v("patchmatch", "weight_delta", m.weight_delta);
-  v("patchmatch", "alpha", m.alpha);
-  v("patchmatch", "beta", m.beta);
-  v("patchmatch", "gamma", m.gamma);
-  v("patchmatch", "lambda_col", m.lambda_col);
-  v("patchmatch", "lambda_grad", m.lambda_grad);
-  v("patchmatch", "lambda_disp", m.lambda_disp);
-  v("patchmatch", "iterations", m.iterations);
-  v("patchmatch", "right_iterations", m.right_iterations);
-  v("patchmatch", "slanted", m.slanted);
-  v("patchmatch", "init_from_prior", m.init_from_prior);
-  v("patchmatch", "init_normal_from_prior", m.init_normal_from_prior);
-  v("patchmatch", "use_lidar_bounds", m.use_lidar_bounds);
-  v("patchmatch", "bound_margin", m.bound_margin);
-  v("patchmatch", "min_refine_range", m.min_refine_range);
-  v("patchmatch", "min_disparity", m.min_disparity);
-  v("patchmatch", "max_disparity", m.max_disparity);
-  v("patchmatch", "view_propagation", m.view_propagation);
-  v("patchmatch", "lr_check", m.lr_check);
-  v("patchmatch", "lr_max_diff", m.lr_max_diff);
-  v("patchmatch", "median_radius", m.median_radius);
-  v("patchmatch", "confidence_weighting", m.confidence_weighting);
-  v("patchmatch", "lock_confidence", m.lock_confidence);
-  v("patchmatch", "fill_confidence", m.fill_confidence);
-  v("patchmatch", "coarse_scale", m.coarse_scale);
-  v("patchmatch", "coarse_levels", m.coarse_levels);
-  v("patchmatch", "full_size_unbounded", m.full_size_unbounded);
-  v("patchmatch", "fine_iterations", m.fine_iterations);
-  v("patchmatch", "fine_refine_range", m.fine_refine_range);
-  v("patchmatch", "fine_right_view", m.fine_right_view);
-  v("patchmatch", "fine_subpixel", m.fine_subpixel);
-  v("patchmatch", "num_threads", m.num_threads);
-  v("patchmatch", "seed", m.seed);
+/// The deprecated spellings of a parameter: ~group/field (the grouped YAML loaded by rosparam) and
+/// group_field (the former dynamic_reconfigure name).
+std::vector<std::string> deprecatedNames(const ParamName& n) {
+  if (*n.group == '\0') return {};
+  return {std::string(n.group) + "/" + n.name, std::string(n.group) + "_" + n.name};
 }
-
-const std::set<std::string>& groups() {
-  static const std::set<std::string> kGroups = {"projection", "bi", "bf", "confidence", "patchmatch"};
-  return kGroups;
-}
-
-std::string rosName(const std::string& group, const std::string& field) {
-  return group.empty() ? field : group + "/" + field;
-}
-std::string reconfigureName(const std::string& group, const std::string& field) {
-  return group.empty() ? field : group + "_" + field;
-}
-
-// Lister --------------------------------------------------------------------------------------
-struct Lister {
-  std::vector<ParamInfo>* out;
-  void add(const std::string& g, const std::string& f, const char* type) {
-    out->push_back({rosName(g, f), reconfigureName(g, f), type});
-  }
-  void operator()(const std::string& g, const std::string& f, double&) { add(g, f, "double"); }
-  void operator()(const std::string& g, const std::string& f, int&) { add(g, f, "int"); }
-  void operator()(const std::string& g, const std::string& f, bool&) { add(g, f, "bool"); }
-  void operator()(const std::string& g, const std::string& f, Method&) { add(g, f, "string"); }
-  void operator()(const std::string& g, const std::string& f, uint64_t&) { add(g, f, "int"); }
-};
 
 // Reading from the parameter server -----------------------------------------------------------
 struct Reader {
   const ros::NodeHandle& nh;
   std::vector<std::string>& errors;
 
-  bool fetch(const std::string& name, XmlRpc::XmlRpcValue& value) const {
-    return nh.hasParam(name) && nh.getParam(name, value);
+  /// The value under the name, or else under a deprecated name (said, and deleted so that the
+  /// parameter server holds one spelling).
+  bool fetch(const ParamName& n, XmlRpc::XmlRpcValue& value) const {
+    bool found = nh.hasParam(n.name) && nh.getParam(n.name, value);
+    for (const std::string& old : deprecatedNames(n)) {
+      XmlRpc::XmlRpcValue old_value;
+      if (!nh.hasParam(old) || !nh.getParam(old, old_value)) continue;
+      if (found) {
+        errors.push_back("parameter " + nh.resolveName(old) + " is a deprecated name of " +
+                         nh.resolveName(n.name) + ", which is also set: ignored");
+      } else {
+        errors.push_back("parameter " + nh.resolveName(old) + " is a deprecated name: use " +
+                         nh.resolveName(n.name) + " (read this time)");
+        value = old_value;
+        found = true;
+      }
+      nh.deleteParam(old);
+    }
+    return found;
   }
-  void wrongType(const std::string& name, const char* expected, XmlRpc::XmlRpcValue& value) {
+  void wrongType(const ParamName& n, const char* expected, XmlRpc::XmlRpcValue& value) {
     std::ostringstream s;
-    s << "parameter " << nh.resolveName(name) << ": expected " << expected << ", got '"
+    s << "parameter " << nh.resolveName(n.name) << ": expected " << expected << ", got '"
       << value.toXml() << "'; keeping the previous value";
     errors.push_back(s.str());
   }
-  void operator()(const std::string& g, const std::string& f, double& out) {
+  void operator()(const ParamName& n, double& out) {
     XmlRpc::XmlRpcValue v;
-    if (!fetch(rosName(g, f), v)) return;
+    if (!fetch(n, v)) return;
     if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
       out = static_cast<double>(v);
     } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
       out = static_cast<int>(v);
     } else {
-      wrongType(rosName(g, f), "a number", v);
+      wrongType(n, "a number", v);
     }
   }
-  void operator()(const std::string& g, const std::string& f, int& out) {
+  void operator()(const ParamName& n, int& out) {
     XmlRpc::XmlRpcValue v;
-    if (!fetch(rosName(g, f), v)) return;
+    if (!fetch(n, v)) return;
     if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
       out = static_cast<int>(v);
     } else {
-      wrongType(rosName(g, f), "an integer", v);
+      wrongType(n, "an integer", v);
     }
   }
-  void operator()(const std::string& g, const std::string& f, bool& out) {
+  void operator()(const ParamName& n, bool& out) {
     XmlRpc::XmlRpcValue v;
-    if (!fetch(rosName(g, f), v)) return;
+    if (!fetch(n, v)) return;
     if (v.getType() == XmlRpc::XmlRpcValue::TypeBoolean) {
       out = static_cast<bool>(v);
     } else {
-      wrongType(rosName(g, f), "true or false", v);
+      wrongType(n, "true or false", v);
     }
   }
-  void operator()(const std::string& g, const std::string& f, Method& out) {
+  void operator()(const ParamName& n, Method& out) {
     XmlRpc::XmlRpcValue v;
-    if (!fetch(rosName(g, f), v)) return;
+    if (!fetch(n, v)) return;
     if (v.getType() != XmlRpc::XmlRpcValue::TypeString) {
-      wrongType(rosName(g, f), "a method name", v);
+      wrongType(n, "a method name", v);
       return;
     }
     try {
       out = parseMethod(static_cast<std::string>(v));
     } catch (const std::exception& e) {
-      errors.push_back("parameter " + nh.resolveName(rosName(g, f)) + ": " + e.what() +
+      errors.push_back("parameter " + nh.resolveName(n.name) + ": " + e.what() +
                        "; keeping the previous value");
     }
   }
-  void operator()(const std::string& g, const std::string& f, uint64_t& out) {
+  void operator()(const ParamName& n, uint64_t& out) {
     XmlRpc::XmlRpcValue v;
-    if (!fetch(rosName(g, f), v)) return;
+    if (!fetch(n, v)) return;
     if (v.getType() == XmlRpc::XmlRpcValue::TypeInt && static_cast<int>(v) >= 0) {
       out = static_cast<uint64_t>(static_cast<int>(v));
     } else {
-      wrongType(rosName(g, f), "a non-negative integer", v);
+      wrongType(n, "a non-negative integer", v);
     }
   }
 };
@@ -177,20 +115,12 @@ struct Reader {
 // Writing to the parameter server -------------------------------------------------------------
 struct Writer {
   const ros::NodeHandle& nh;
-  void operator()(const std::string& g, const std::string& f, double& v) {
-    nh.setParam(rosName(g, f), v);
-  }
-  void operator()(const std::string& g, const std::string& f, int& v) {
-    nh.setParam(rosName(g, f), v);
-  }
-  void operator()(const std::string& g, const std::string& f, bool& v) {
-    nh.setParam(rosName(g, f), v);
-  }
-  void operator()(const std::string& g, const std::string& f, Method& v) {
-    nh.setParam(rosName(g, f), methodName(v));
-  }
-  void operator()(const std::string& g, const std::string& f, uint64_t& v) {
-    nh.setParam(rosName(g, f), static_cast<int>(v));
+  void operator()(const ParamName& n, const double& v) { nh.setParam(n.name, v); }
+  void operator()(const ParamName& n, const int& v) { nh.setParam(n.name, v); }
+  void operator()(const ParamName& n, const bool& v) { nh.setParam(n.name, v); }
+  void operator()(const ParamName& n, const Method& v) { nh.setParam(n.name, methodName(v)); }
+  void operator()(const ParamName& n, const uint64_t& v) {
+    nh.setParam(n.name, static_cast<int>(v));
   }
 };
 
@@ -207,102 +137,103 @@ Entry* findEntry(std::vector<Entry>& entries, const std::string& name) {
 /// Writes FusionParams into a dynamic_reconfigure::Config message.
 struct ToMessage {
   dynamic_reconfigure::Config& msg;
-  void operator()(const std::string& g, const std::string& f, double& v) {
-    findEntry(msg.doubles, reconfigureName(g, f))->value = v;
+  void operator()(const ParamName& n, const double& v) {
+    findEntry(msg.doubles, n.name)->value = v;
   }
-  void operator()(const std::string& g, const std::string& f, int& v) {
-    findEntry(msg.ints, reconfigureName(g, f))->value = v;
+  void operator()(const ParamName& n, const int& v) { findEntry(msg.ints, n.name)->value = v; }
+  void operator()(const ParamName& n, const bool& v) { findEntry(msg.bools, n.name)->value = v; }
+  void operator()(const ParamName& n, const Method& v) {
+    findEntry(msg.strs, n.name)->value = methodName(v);
   }
-  void operator()(const std::string& g, const std::string& f, bool& v) {
-    findEntry(msg.bools, reconfigureName(g, f))->value = v;
-  }
-  void operator()(const std::string& g, const std::string& f, Method& v) {
-    findEntry(msg.strs, reconfigureName(g, f))->value = methodName(v);
-  }
-  void operator()(const std::string& g, const std::string& f, uint64_t& v) {
+  void operator()(const ParamName& n, const uint64_t& v) {
     const uint64_t max = static_cast<uint64_t>(std::numeric_limits<int>::max());
-    findEntry(msg.ints, reconfigureName(g, f))->value = static_cast<int>(v > max ? max : v);
+    findEntry(msg.ints, n.name)->value = static_cast<int>(v > max ? max : v);
   }
 };
 
-/// Reads FusionParams from a dynamic_reconfigure::Config message.
+/// Reads FusionParams from a dynamic_reconfigure::Config message; throws std::invalid_argument
+/// naming the parameter for values no field can hold.
 struct FromMessage {
   dynamic_reconfigure::Config& msg;
-  void operator()(const std::string& g, const std::string& f, double& v) {
-    v = findEntry(msg.doubles, reconfigureName(g, f))->value;
+  void operator()(const ParamName& n, double& v) {
+    v = findEntry(msg.doubles, n.name)->value;
+    if (!std::isfinite(v)) throw std::invalid_argument(std::string(n.name) + " must be finite");
   }
-  void operator()(const std::string& g, const std::string& f, int& v) {
-    v = findEntry(msg.ints, reconfigureName(g, f))->value;
-  }
-  void operator()(const std::string& g, const std::string& f, bool& v) {
-    v = findEntry(msg.bools, reconfigureName(g, f))->value;
-  }
-  void operator()(const std::string& g, const std::string& f, Method& v) {
-    const std::string& name = findEntry(msg.strs, reconfigureName(g, f))->value;
+  void operator()(const ParamName& n, int& v) { v = findEntry(msg.ints, n.name)->value; }
+  void operator()(const ParamName& n, bool& v) { v = findEntry(msg.bools, n.name)->value; }
+  void operator()(const ParamName& n, Method& v) {
+    const std::string& name = findEntry(msg.strs, n.name)->value;
     try {
       v = parseMethod(name);
     } catch (const std::exception& e) {
-      throw std::invalid_argument(reconfigureName(g, f) + ": " + e.what());
+      throw std::invalid_argument(std::string(n.name) + ": " + e.what());
     }
   }
-  void operator()(const std::string& g, const std::string& f, uint64_t& v) {
-    const int value = findEntry(msg.ints, reconfigureName(g, f))->value;
+  void operator()(const ParamName& n, uint64_t& v) {
+    const int value = findEntry(msg.ints, n.name)->value;
     if (value < 0) {
-      throw std::invalid_argument(reconfigureName(g, f) + " must be >= 0, got " +
+      throw std::invalid_argument(std::string(n.name) + " must be >= 0, got " +
                                   std::to_string(value));
     }
     v = static_cast<uint64_t>(value);
   }
 };
 
+/// Every entry of a Config message as name -> text.
+std::vector<std::pair<std::string, std::string>> messageEntries(
+    const dynamic_reconfigure::Config& m) {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& e : m.strs) out.emplace_back(e.name, e.value);
+  for (const auto& e : m.doubles) out.emplace_back(e.name, formatParamDouble(e.value));
+  for (const auto& e : m.ints) out.emplace_back(e.name, std::to_string(e.value));
+  for (const auto& e : m.bools) out.emplace_back(e.name, e.value ? "true" : "false");
+  return out;
+}
+
 /// Collects every field as text, for describeChanges().
 struct Stringifier {
   std::vector<std::pair<std::string, std::string>> out;
   template <class T>
-  void operator()(const std::string& g, const std::string& f, T& v) {
+  void operator()(const ParamName& n, const T& v) {
     std::ostringstream s;
     s << std::boolalpha << v;
-    out.emplace_back(rosName(g, f), s.str());
+    out.emplace_back(n.name, s.str());
   }
-  void operator()(const std::string& g, const std::string& f, Method& v) {
-    out.emplace_back(rosName(g, f), methodName(v));
+  void operator()(const ParamName& n, const double& v) {
+    out.emplace_back(n.name, formatParamDouble(v));
   }
+  void operator()(const ParamName& n, const Method& v) { out.emplace_back(n.name, methodName(v)); }
 };
 
 }  // namespace
 
-std::vector<ParamInfo> listParams() {
-  std::vector<ParamInfo> out;
-  FusionParams p;
-  visitParams(p, Lister{&out});
-  return out;
-}
+std::vector<ParamInfo> listParams() { return paramTable(); }
 
 FusionParams readParams(const ros::NodeHandle& pnh, const FusionParams& base,
                         std::vector<std::string>* errors) {
   std::vector<std::string> local;
   std::vector<std::string>& errs = errors ? *errors : local;
   FusionParams p = base;
-  visitParams(p, Reader{pnh, errs});
-  // rosparam and YAML bypass dynamic_reconfigure's range; a thread count beyond it crashes libgomp.
+  visitParamTable(p, Reader{pnh, errs});
+  // rosparam bypasses validate() until the whole set is checked; a thread count beyond this
+  // crashes libgomp, so it is refused on its own.
   if (p.patchmatch.num_threads < 0 || p.patchmatch.num_threads > kMaxThreads) {
-    errs.push_back("parameter " + pnh.resolveName("patchmatch/num_threads") + " = " +
+    errs.push_back("parameter " + pnh.resolveName("num_threads") + " = " +
                    std::to_string(p.patchmatch.num_threads) + " is out of range [0, " +
                    std::to_string(kMaxThreads) + "] (0 = all cores); keeping " +
                    std::to_string(base.patchmatch.num_threads));
     p.patchmatch.num_threads = base.patchmatch.num_threads;
   }
 
-  // Unknown keys under the groups are typos: name them (they would otherwise be ignored).
-  std::set<std::string> known;
-  for (const auto& info : listParams()) known.insert(pnh.resolveName(info.ros_name));
+  // Keys left under the old groups are typos (the known ones were read and deleted above).
   std::vector<std::string> names;
   if (ros::param::getParamNames(names)) {
-    for (const auto& group : groups()) {
+    for (const auto& group : paramGroups()) {
       const std::string prefix = pnh.resolveName(group) + "/";
       for (const auto& name : names) {
-        if (name.compare(0, prefix.size(), prefix) == 0 && !known.count(name)) {
-          errs.push_back("unknown parameter " + name + " (typo?) is ignored");
+        if (name.compare(0, prefix.size(), prefix) == 0) {
+          errs.push_back("unknown parameter " + name + " (typo? parameters have no group: ~" +
+                         name.substr(prefix.size()) + ") is ignored");
         }
       }
     }
@@ -311,16 +242,14 @@ FusionParams readParams(const ros::NodeHandle& pnh, const FusionParams& base,
 }
 
 void writeParams(const ros::NodeHandle& pnh, const FusionParams& params) {
-  FusionParams p = params;
-  visitParams(p, Writer{pnh});
+  visitParamTable(params, Writer{pnh});
 }
 
 FusionConfig toConfig(const FusionParams& params) {
   FusionConfig config = FusionConfig::__getDefault__();
   dynamic_reconfigure::Config msg;
   config.__toMessage__(msg);
-  FusionParams p = params;
-  visitParams(p, ToMessage{msg});
+  visitParamTable(params, ToMessage{msg});
   config.__fromMessage__(msg);
   return config;
 }
@@ -329,15 +258,14 @@ FusionParams fromConfig(const FusionConfig& config) {
   dynamic_reconfigure::Config msg;
   config.__toMessage__(msg);
   FusionParams p;
-  visitParams(p, FromMessage{msg});
+  visitParamTable(p, FromMessage{msg});
   return p;
 }
 
 std::string describeChanges(const FusionParams& from, const FusionParams& to) {
-  FusionParams a = from, b = to;
   Stringifier sa, sb;
-  visitParams(a, sa);
-  visitParams(b, sb);
+  visitParamTable(from, sa);
+  visitParamTable(to, sb);
   std::string out;
   for (size_t i = 0; i < sa.out.size(); ++i) {
     if (sa.out[i].second == sb.out[i].second) continue;
@@ -345,6 +273,22 @@ std::string describeChanges(const FusionParams& from, const FusionParams& to) {
     out += sa.out[i].first + ": " + sa.out[i].second + " -> " + sb.out[i].second;
   }
   return out;
+}
+
+std::string describeRequest(const FusionParams& current, const FusionConfig& requested) {
+  dynamic_reconfigure::Config now, asked;
+  toConfig(current).__toMessage__(now);
+  requested.__toMessage__(asked);
+  const auto a = messageEntries(now), b = messageEntries(asked);
+  std::string out;
+  for (const auto& [name, value] : b) {
+    for (const auto& [old_name, old_value] : a) {
+      if (old_name != name || old_value == value) continue;
+      if (!out.empty()) out += ", ";
+      out += name + " = " + value + " (in force: " + old_value + ")";
+    }
+  }
+  return out.empty() ? "no change" : out;
 }
 
 }  // namespace ros_params

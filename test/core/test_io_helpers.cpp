@@ -1,5 +1,6 @@
 // The small io helpers on synthetic input with exact answers: ring hold-out, row-sampled
 // pseudo-LiDAR, colour maps, tables, progress bar, command line.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -183,6 +184,25 @@ TEST(Visualization, EmptyPixelsAreBlackAndTheScaleFollowsTheMaximum) {
       overlaySparse(cv::Mat(5, 5, CV_8UC3, cv::Scalar::all(100)), cv::Mat1f(5, 5, 0.f));
   EXPECT_EQ(overlay.at<cv::Vec3b>(2, 2), cv::Vec3b(40, 40, 40));  // darkened to 40 %
   EXPECT_THROW(overlaySparse(cv::Mat(5, 5, CV_8UC3), cv::Mat1f(4, 5)), std::invalid_argument);
+}
+
+// --save-vis pictures carry their scale (issue 10): a colour bar below, in the picture's colours.
+TEST(Visualization, ColourBarBelowThePictureGoesFromLevel0ToLevel255) {
+  cv::Mat1f z(20, 400, 10.f);
+  const cv::Mat picture = colorizeDepth(z, 80.0);
+  const cv::Mat with_bar = withColorBar(picture, 80.0, 0.0, "m");
+  ASSERT_EQ(with_bar.cols, picture.cols);
+  ASSERT_GT(with_bar.rows, picture.rows + 10);
+  EXPECT_EQ(cv::norm(with_bar(cv::Rect(0, 0, 400, 20)), picture, cv::NORM_INF), 0.0);
+  cv::Mat1b level(1, 2);
+  level(0, 0) = 0;
+  level(0, 1) = 255;
+  cv::Mat ends;
+  cv::applyColorMap(level, ends, cv::COLORMAP_TURBO);
+  const int margin = std::max(8, 400 / 40), bar_row = picture.rows + 4;
+  EXPECT_EQ(with_bar.at<cv::Vec3b>(bar_row, margin), ends.at<cv::Vec3b>(0, 0));
+  EXPECT_EQ(with_bar.at<cv::Vec3b>(bar_row, 400 - margin - 1), ends.at<cv::Vec3b>(0, 1));
+  EXPECT_THROW(withColorBar(cv::Mat1b(2, 2), 0, 1, ""), std::invalid_argument);
 }
 
 TEST(Report, TablesMedianAndProgress) {

@@ -2,6 +2,8 @@
 // typos and bad values are errors naming the key.
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -199,6 +201,34 @@ TEST(ParamsYaml, PartialRosparamStyleFileOverridesOnlyWhatItNames) {
   expected.patchmatch.lr_check = false;
   expected.patchmatch.seed = 7;
   expectSame(p, expected);
+}
+
+// One name per parameter (issue 10): the keys are the names of io/param_table.h at the top level,
+// as rosparam and dynamic_reconfigure spell them; the former sections are still read.
+TEST(ParamsYaml, TopLevelNamesAndTheDeprecatedSectionsGiveTheSameParameters) {
+  YamlFile flat("method: pms\nmax_depth: 120\nwindow_radius: 7\nslanted: false\nseed: 7\n");
+  YamlFile grouped(
+      "method: pms\nprojection: {max_depth: 120}\n"
+      "patchmatch: {window_radius: 7, slanted: false, seed: 7}\n");
+  FusionParams a, b;
+  loadParamsYaml(flat.path(), a);
+  loadParamsYaml(grouped.path(), b);
+  expectSame(a, b);
+  EXPECT_EQ(a.patchmatch.window_radius, 7);
+  EXPECT_EQ(a.projection.max_depth, 120.0);
+  const std::string twice = loadError("window_radius: 7\npatchmatch: {window_radius: 6}\n");
+  EXPECT_NE(twice.find("'window_radius' is given twice"), std::string::npos) << twice;
+  const std::string wrong_group = loadError("bi: {window_radius: 6}\n");
+  EXPECT_NE(wrong_group.find("'window_radius'"), std::string::npos) << wrong_group;
+}
+
+TEST(ParamsYaml, TheWriterUsesTheOneNames) {
+  YamlFile file;
+  saveParamsYaml(file.path(), everyFieldChanged());
+  std::ifstream in(file.path());
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\nwindow_radius: "), std::string::npos) << text;
+  EXPECT_EQ(text.find("patchmatch:"), std::string::npos) << text;
 }
 
 TEST(ParamsYaml, CommentsAfterStringAndBooleanValuesAreIgnored) {

@@ -183,6 +183,16 @@ TEST(AutowareCalibration, MalformedLayoutIsRefusedNamingTheLine) {
     EXPECT_NE(std::string(e.what()).find("line 3 is not 'Key: value' (5, -1,)"), std::string::npos)
         << e.what();
   }
+  // Another hang found by fuzzing: indented lines with no key above them.
+  TempYaml orphan("%YAML:1.0\n\n   \n   cols: 5\n   dt: d\n 1, -0.5 ]\n");
+  try {
+    readAutowareCalibration(orphan.path());
+    ADD_FAILURE() << "indented lines without a key were accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("line 4 is indented but no 'Key: value' line"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

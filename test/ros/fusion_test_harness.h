@@ -33,8 +33,9 @@ constexpr double kNoOutputWait = 1.5;    ///< [s] > max_sweep_wait + processing 
 
 /// The output topics, relative to the fusion namespace.
 const std::vector<std::string> kOutputs = {
-    "disparity",       "depth",           "depth/camera_info", "points2",
-    "lidar_disparity", "disparity_image", "confidence",        "stats"};
+    "disparity",         "depth/image_rect", "depth/camera_info",
+    "depth/image_color", "points2",          "lidar_disparity",
+    "disparity_image",   "confidence",       "stats"};
 
 /// How one input set is made.
 struct SetSpec {
@@ -57,6 +58,8 @@ class Harness {
     process_node_ = pnh_.param<std::string>("process_node", "/fusion/fusion_manager");
     fusion_node_ = pnh_.param<std::string>("fusion_node", "/fusion/fusion");
     ns_ = pnh_.param<std::string>("fusion_ns", "/fusion");
+    // stereo_image_proc (image_geometry) needs both camera_infos in one frame: the left one.
+    right_frame_ = pnh_.param<std::string>("right_frame", kRightCameraFrame);
     frames_ = lsf::test::makeFrames(3, kWidth, kHeight);
     left_image_ = nh_.advertise<sensor_msgs::Image>("/stereo/left/image_rect_color", 5);
     left_info_ = nh_.advertise<sensor_msgs::CameraInfo>("/stereo/left/camera_info", 5);
@@ -141,11 +144,10 @@ class Harness {
       right_bgr = frame.right(cv::Rect(0, 0, spec.right_width, frame.right.rows)).clone();
       right_camera.width = spec.right_width;
     }
-    auto right =
-        lsf::test::imageMsg(right_bgr, spec.right_encoding, kRightCameraFrame, right_stamp);
+    auto right = lsf::test::imageMsg(right_bgr, spec.right_encoding, right_frame_, right_stamp);
     auto linfo = lsf::test::cameraInfoMsg(frame.camera, false, kCameraFrame, stamp);
-    auto rinfo = lsf::test::cameraInfoMsg(right_camera, true, kRightCameraFrame, right_stamp,
-                                          spec.positive_tx);
+    auto rinfo =
+        lsf::test::cameraInfoMsg(right_camera, true, right_frame_, right_stamp, spec.positive_tx);
     auto cloud = makeCloud(spec, stamp);
     if (cloud && spec.cloud_first) cloud_.publish(cloud);
     left_info_.publish(linfo);
@@ -314,7 +316,7 @@ class Harness {
   }
 
   ros::NodeHandle nh_, pnh_;
-  std::string process_node_, fusion_node_, ns_;
+  std::string process_node_, fusion_node_, ns_, right_frame_;
   std::vector<lsf::sim::SyntheticFrame> frames_;
   ros::Publisher left_image_, left_info_, right_image_, right_info_, cloud_;
   tf2_ros::StaticTransformBroadcaster tf_broadcaster_;

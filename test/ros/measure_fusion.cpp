@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
       ns + "/depth/camera_info", 1, +[](const sensor_msgs::CameraInfoConstPtr&) {}));
   keep.push_back(nh.subscribe<sensor_msgs::PointCloud2>(
       ns + "/points2", 1, +[](const sensor_msgs::PointCloud2ConstPtr&) {}));
-  for (const char* image : {"/depth", "/lidar_disparity", "/disparity_image"}) {
+  for (const char* image : {"/depth/image_rect", "/lidar_disparity", "/disparity_image"}) {
     keep.push_back(nh.subscribe<sensor_msgs::Image>(
         ns + image, 1, +[](const sensor_msgs::ImageConstPtr&) {}));
   }

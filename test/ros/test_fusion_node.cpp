@@ -122,7 +122,7 @@ TEST_F(FusionNode, A_LazySubscription) {
   }
 
   // One subscriber on one output is enough; when it leaves, the inputs are dropped again.
-  for (const std::string output : {"stats", "depth", "points2"}) {
+  for (const std::string output : {"stats", "depth/image_rect", "points2"}) {
     h().subscribeOutputs({output});
     EXPECT_TRUE(h().inputsSubscribed(true, 10.0)) << "no input subscription for " << output;
     h().unsubscribeOutputs();
@@ -130,19 +130,21 @@ TEST_F(FusionNode, A_LazySubscription) {
   }
 }
 
-// Crash 3 of issue 9: the .test files set ~patchmatch/num_threads to 100000 through rosparam
-// (~expect_num_threads_rejected); libgomp crashed at the first frame. The node keeps the default,
-// says so, and writes the value in use back to the parameter server.
+// Crash 3 of issue 9: the .test files set ~num_threads (fusion_node.test: under its deprecated
+// name ~patchmatch/num_threads) to 100000 through rosparam (~expect_num_threads_rejected); libgomp
+// crashed at the first frame. The node keeps the default, says so, and writes the value in use
+// back to the parameter server under the one name; the deprecated spelling is gone (issue 10).
 TEST_F(FusionNode, A2_ThreadCountBeyondTheCapIsNotApplied) {
   ros::NodeHandle pnh("~");
   if (!pnh.param("expect_num_threads_rejected", false)) GTEST_SKIP() << "not set in this .test";
   int threads = -1;
   ASSERT_TRUE(Harness::waitFor(30.0, [&] {
-    return ros::param::get(h().fusionNode() + "/patchmatch/num_threads", threads) &&
-           threads != 100000;
+    return ros::param::get(h().fusionNode() + "/num_threads", threads) && threads != 100000;
   })) << "the node did not replace num_threads 100000 by the value in use";
   EXPECT_GE(threads, 0);
   EXPECT_LE(threads, 256);
+  EXPECT_FALSE(ros::param::has(h().fusionNode() + "/patchmatch/num_threads"));
+  EXPECT_FALSE(ros::param::has(h().fusionNode() + "/patchmatch_num_threads"));
   EXPECT_TRUE(h().processAlive());
 }
 
@@ -179,7 +181,7 @@ TEST_F(FusionNode, B_OneOutputPerInputSetOnEveryTopic) {
     EXPECT_LE(disparity->valid_window.x_offset + disparity->valid_window.width,
               static_cast<uint32_t>(kWidth));
 
-    auto depth = h().image("depth");
+    auto depth = h().image("depth/image_rect");
     ASSERT_TRUE(depth);
     EXPECT_EQ(depth->encoding, sensor_msgs::image_encodings::TYPE_32FC1);
     double median_rel = 1, coverage = 0;
@@ -441,26 +443,46 @@ TEST_F(FusionNode, K_ParametersChangeLiveAndInvalidOnesAreRejected) {
     return std::nan("");
   };
 
-  // alpha + beta + gamma != 1: rejected with an error naming the parameter, old values kept.
+  // alpha + beta + gamma != 1: refused with an error naming the parameter; the response carries
+  // the value in force.
   std::size_t mark = h().logMark();
   dynamic_reconfigure::Config result;
   ASSERT_TRUE(set(
       [](dynamic_reconfigure::Config& c) {
         dynamic_reconfigure::DoubleParameter p;
-        p.name = "patchmatch_alpha";
+        p.name = "alpha";
         p.value = 0.5;
         c.doubles.push_back(p);
       },
       &result));
   const double default_alpha = lidar_stereo_fusion::PatchMatchParams().alpha;
-  EXPECT_DOUBLE_EQ(value(result, "patchmatch_alpha"), default_alpha);
-  EXPECT_TRUE(h().waitForLog(mark, {"patchmatch/alpha"})) << h().logsSince(mark);
+  EXPECT_DOUBLE_EQ(value(result, "alpha"), default_alpha);
+  EXPECT_TRUE(h().waitForLog(mark, {"refused", "alpha + beta + gamma", "alpha = 0.5 (in force: "}))
+      << h().logsSince(mark);
   auto stats = goodSetStats();
   ASSERT_TRUE(stats);
   EXPECT_EQ(stats->method, "fused_bi");
   double alpha = 0;
-  ros::param::get(h().fusionNode() + "/patchmatch/alpha", alpha);
+  ros::param::get(h().fusionNode() + "/alpha", alpha);
   EXPECT_DOUBLE_EQ(alpha, default_alpha);
+
+  // An unknown method: refused as asked ("bogus"), not reported as some other change.
+  mark = h().logMark();
+  ASSERT_TRUE(set(
+      [](dynamic_reconfigure::Config& c) {
+        dynamic_reconfigure::StrParameter p;
+        p.name = "method";
+        p.value = "bogus";
+        c.strs.push_back(p);
+      },
+      &result));
+  std::string answered;
+  for (const auto& p : result.strs) {
+    if (p.name == "method") answered = p.value;
+  }
+  EXPECT_EQ(answered, "fused_bi");
+  EXPECT_TRUE(h().waitForLog(mark, {"refused", "method = bogus (in force: fused_bi)"}))
+      << h().logsSince(mark);
 
   // A valid change applies to the next frame.
   ASSERT_TRUE(set(

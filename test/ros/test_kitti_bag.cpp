@@ -88,7 +88,7 @@ class OutputCollector {
  public:
   explicit OutputCollector(ros::NodeHandle& nh) {
     subs_.push_back(subscribe<stereo_msgs::DisparityImage>(nh, "disparity", &disparity_));
-    subs_.push_back(subscribe<sensor_msgs::Image>(nh, "depth", &depth_));
+    subs_.push_back(subscribe<sensor_msgs::Image>(nh, "depth/image_rect", &depth_));
     subs_.push_back(subscribe<sensor_msgs::CameraInfo>(nh, "depth/camera_info", &depth_info_));
     subs_.push_back(subscribe<sensor_msgs::PointCloud2>(nh, "points2", &points_));
     subs_.push_back(subscribe<sensor_msgs::Image>(nh, "lidar_disparity", &lidar_disparity_));

@@ -133,7 +133,7 @@ TEST(KittiBagRates, EveryPublishedDepthIsItsOwnFramesAtAnyPlaybackRate) {
   ros::NodeHandle nh("fusion");
   Collector got;
   auto depth_sub = nh.subscribe<sensor_msgs::Image>(
-      "depth", 10, [&](const sensor_msgs::ImageConstPtr& m) { got.add(got.depth, m); });
+      "depth/image_rect", 10, [&](const sensor_msgs::ImageConstPtr& m) { got.add(got.depth, m); });
   auto confidence_sub = nh.subscribe<sensor_msgs::Image>(
       "confidence", 10, [&](const sensor_msgs::ImageConstPtr& m) { got.add(got.confidence, m); });
 

@@ -9,6 +9,7 @@
 
 #include "lidar_stereo_fusion/ros/conversions.h"
 #include "lidar_stereo_fusion/ros/input_gate.h"
+#include "lidar_stereo_fusion/ros/input_watch.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 #include "lidar_stereo_fusion/ros/output_publisher.h"
 
@@ -125,6 +126,29 @@ TEST(ThrottledLog, OncePerPeriodPerTopicAndKindWithABoundedKeySet) {
   EXPECT_TRUE(log.shouldLog("velodyne_points", "layout", t0 + ros::WallDuration(5.1)));
   for (int i = 0; i < 1000; ++i) log.shouldLog("topic" + std::to_string(i), "kind", t0);
   EXPECT_LE(log.keys(), lsf::ThrottledLog::kMaxKeys);
+}
+
+// Issue 10, point 4: an input topic that sends nothing is named; one that went quiet once.
+TEST(InputWatch, NamesSilentTopicsAfterTheTimeout) {
+  lsf::ThrottledLog log("test", 0.0);
+  lsf::InputWatch watch({"/a", "/b"}, 2.0, log);
+  using Clock = lsf::InputWatch::Clock;
+  const Clock::time_point t0 = Clock::now();
+  const auto at = [&](double s) {
+    return t0 + std::chrono::milliseconds(static_cast<int>(s * 1e3));
+  };
+  const auto none = [](std::size_t) { return 0u; };
+  EXPECT_TRUE(watch.check(none, at(10)).empty()) << "not watching before start()";
+  watch.start(at(0));
+  watch.heard(0, at(0.5));
+  EXPECT_TRUE(watch.check(none, at(1.9)).empty());
+  EXPECT_EQ(watch.check(none, at(2.1)), (std::vector<std::size_t>{1}));     // /b never sent
+  EXPECT_EQ(watch.check(none, at(2.6)), (std::vector<std::size_t>{0, 1}));  // /a quiet for 2.1 s
+  watch.heard(0, at(3.0));
+  watch.heard(1, at(3.0));
+  EXPECT_TRUE(watch.check(none, at(4.0)).empty());
+  watch.stop();
+  EXPECT_TRUE(watch.check(none, at(60.0)).empty()) << "not watching after stop()";
 }
 
 TEST(OutputPublisher, LatencyNeverGoesNegativeAfterABagLoop) {

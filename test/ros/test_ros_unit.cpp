@@ -341,8 +341,10 @@ TEST(Conversions, DepthHasNanWhereEmptyOrTooFar) {
 
 TEST(Conversions, DisparityImageLikeStereoImageProc) {
   cv::Mat1f disparity(10, 20, 0.f);
-  disparity(3, 4) = 0.6f;    // below the search range: widens min_disparity
-  disparity(7, 15) = 250.f;  // above: widens max_disparity
+  disparity(3, 4) = 2.5f;
+  disparity(7, 15) = 191.f;
+  disparity(1, 1) = 0.6f;    // below the search range: no value
+  disparity(8, 18) = 250.f;  // above: no value
   lsf::StereoCamera camera;
   camera.fx = 500;
   camera.baseline = 0.3;
@@ -350,8 +352,13 @@ TEST(Conversions, DisparityImageLikeStereoImageProc) {
   const auto msg = conv::disparityToMsg(disparity, header, camera, 1.0, 192.0);
   EXPECT_FLOAT_EQ(msg->f, 500.f);
   EXPECT_FLOAT_EQ(msg->T, 0.3f);
-  EXPECT_FLOAT_EQ(msg->min_disparity, 0.6f);
-  EXPECT_FLOAT_EQ(msg->max_disparity, 250.f);
+  // The configured search range (issue 10), not this frame's values.
+  EXPECT_FLOAT_EQ(msg->min_disparity, 1.f);
+  EXPECT_FLOAT_EQ(msg->max_disparity, 192.f);
+  const float* d = reinterpret_cast<const float*>(msg->image.data.data());
+  EXPECT_EQ(d[1 * 20 + 1], 0.f);
+  EXPECT_EQ(d[8 * 20 + 18], 0.f);
+  EXPECT_EQ(d[3 * 20 + 4], 2.5f);
   EXPECT_GT(msg->min_disparity, 0.f) << "0 (no value) must be below min_disparity";
   EXPECT_EQ(msg->valid_window.x_offset, 4u);
   EXPECT_EQ(msg->valid_window.y_offset, 3u);
@@ -361,16 +368,49 @@ TEST(Conversions, DisparityImageLikeStereoImageProc) {
 }
 
 TEST(Conversions, ColouredCloudPacksRgbLikePcl) {
-  std::vector<lsf::ColoredPoint> points(1);
-  points[0] = {1.f, 2.f, 3.f, 200, 100, 50};
+  lsf::OrganizedCloud points;
+  points.width = 1;
+  points.height = 1;
+  points.points = {{1.f, 2.f, 3.f, 200, 100, 50}};
   std_msgs::Header header;
   const auto msg = conv::coloredCloudToMsg(points, header);
+  EXPECT_TRUE(msg->is_dense);
   sensor_msgs::PointCloud2ConstIterator<uint8_t> r(*msg, "r"), g(*msg, "g"), b(*msg, "b");
   EXPECT_EQ(*r, 200);
   EXPECT_EQ(*g, 100);
   EXPECT_EQ(*b, 50);
   sensor_msgs::PointCloud2ConstIterator<float> z(*msg, "z");
   EXPECT_FLOAT_EQ(*z, 3.f);
+}
+
+TEST(Conversions, OrganisedCloudKeepsTheGridWithNanForNoValue) {
+  lsf::StereoCamera camera;
+  camera.fx = camera.fy = 100;
+  camera.cx = 1.5;
+  camera.cy = 1;
+  camera.baseline = 0.5;
+  camera.width = 4;
+  camera.height = 3;
+  cv::Mat1f depth(3, 4, 0.f);
+  depth(2, 3) = 10.f;
+  const cv::Mat3b image(3, 4, cv::Vec3b(1, 2, 3));
+  const auto msg =
+      conv::coloredCloudToMsg(lsf::makeOrganizedCloud(depth, image, camera), std_msgs::Header());
+  EXPECT_EQ(msg->height, 3u);
+  EXPECT_EQ(msg->width, 4u);
+  EXPECT_EQ(msg->row_step, 4u * msg->point_step);
+  EXPECT_FALSE(msg->is_dense);
+  sensor_msgs::PointCloud2ConstIterator<float> z(*msg, "z");
+  for (int i = 0; i < 12; ++i, ++z) {
+    if (i == 2 * 4 + 3) {
+      EXPECT_FLOAT_EQ(*z, 10.f);
+    } else {
+      EXPECT_TRUE(std::isnan(*z)) << i;
+    }
+  }
+  const auto strided = lsf::makeOrganizedCloud(depth, image, camera, 2);
+  EXPECT_EQ(strided.width, 2);
+  EXPECT_EQ(strided.height, 2);
 }
 
 // --- sweep matching ------------------------------------------------------------------------------
@@ -538,18 +578,39 @@ std::map<std::string, std::string> configEntries(const lsf::FusionConfig& config
 }
 }  // namespace
 
-TEST(RosParams, ReconfigureHasExactlyTheCoreParameters) {
+TEST(RosParams, ReconfigureHasExactlyTheTableWithTheSameNamesAndGroups) {
+  // One name per parameter (issue 10): the cfg name is the table's, the cfg group its group.
   const auto entries = configEntries(lsf::FusionConfig::__getDefault__());
+  std::map<std::string, std::string> cfg_group;
+  for (const auto& g : lsf::FusionConfig::__getDescriptionMessage__().groups) {
+    for (const auto& param : g.parameters)
+      cfg_group[param.name] = g.name == "Default" ? "" : g.name;
+  }
   std::set<std::string> listed;
   for (const auto& info : lsf::ros_params::listParams()) {
-    listed.insert(info.reconfigure_name);
-    ASSERT_TRUE(entries.count(info.reconfigure_name))
-        << info.reconfigure_name << " is missing from cfg/Fusion.cfg";
-    EXPECT_EQ(entries.at(info.reconfigure_name).substr(0, info.type.size()), info.type)
-        << info.reconfigure_name;
+    listed.insert(info.name);
+    ASSERT_TRUE(entries.count(info.name)) << info.name << " is missing from cfg/Fusion.cfg";
+    EXPECT_EQ(entries.at(info.name).substr(0, info.type.size()), info.type) << info.name;
+    EXPECT_EQ(cfg_group[info.name], info.group) << info.name << ": group in cfg/Fusion.cfg";
   }
   for (const auto& kv : entries) {
-    EXPECT_TRUE(listed.count(kv.first)) << kv.first << " in cfg/Fusion.cfg is not a core parameter";
+    EXPECT_TRUE(listed.count(kv.first))
+        << kv.first << " in cfg/Fusion.cfg is not in io/param_table.h";
+  }
+}
+
+TEST(RosParams, ReconfigureHasNoSliderRangeThatWouldClampSilently) {
+  // Out-of-range values must reach the node, which refuses them visibly (issue 10).
+  const auto min = configEntries(lsf::FusionConfig::__getMin__());
+  const auto max = configEntries(lsf::FusionConfig::__getMax__());
+  for (const auto& info : lsf::ros_params::listParams()) {
+    if (info.type == "double") {
+      EXPECT_EQ(min.at(info.name), "double -inf") << info.name;
+      EXPECT_EQ(max.at(info.name), "double inf") << info.name;
+    } else if (info.type == "int") {
+      EXPECT_EQ(min.at(info.name), "int " + std::to_string(std::numeric_limits<int>::min()))
+          << info.name;
+    }
   }
 }
 
@@ -575,8 +636,8 @@ TEST(RosParams, ConfigRoundTripKeepsEveryField) {
   EXPECT_EQ(q.method, lsf::Method::kFusedBF);
   EXPECT_EQ(q.patchmatch.seed, 1234u);
   EXPECT_NE(lsf::ros_params::describeChanges(lsf::FusionParams(), p)
-                .find("patchmatch/window_radius: " +
-                      std::to_string(lsf::PatchMatchParams().window_radius) + " -> 9"),
+                .find("window_radius: " + std::to_string(lsf::PatchMatchParams().window_radius) +
+                      " -> 9"),
             std::string::npos)
       << lsf::ros_params::describeChanges(lsf::FusionParams(), p);
 }
@@ -603,40 +664,71 @@ cv::FileStorage openRosparamYaml(const std::string& path) {
 }  // namespace
 
 TEST(RosParams, EveryFieldTheCoreYamlWriterKnowsIsARosParameter) {
-  // saveParamsYaml writes every field of FusionParams: a field added to the core must also be
-  // added to ros_params.cpp and cfg/Fusion.cfg.
+  // saveParamsYaml writes every field of the table, at the top level, under the one name.
   const std::string path = std::string(LSF_BINARY_DIR) + "/test_ros_unit_params.yaml";
   lsf::saveParamsYaml(path, lsf::FusionParams());
   cv::FileStorage fs = openRosparamYaml(path);
   ASSERT_TRUE(fs.isOpened());
   std::set<std::string> core;
   for (const cv::FileNode& node : fs.root()) {
-    if (node.isMap()) {
-      for (const cv::FileNode& field : node) core.insert(node.name() + "/" + field.name());
-    } else {
-      core.insert(node.name());
-    }
+    EXPECT_FALSE(node.isMap()) << node.name() << ": no sections";
+    core.insert(node.name());
   }
   std::set<std::string> ros;
-  for (const auto& info : lsf::ros_params::listParams()) ros.insert(info.ros_name);
-  for (const auto& name : core) EXPECT_TRUE(ros.count(name)) << name << " is not a ROS parameter";
-  for (const auto& name : ros) EXPECT_TRUE(core.count(name)) << name << " is not a core field";
+  for (const auto& info : lsf::ros_params::listParams()) ros.insert(info.name);
+  EXPECT_EQ(core, ros);
 }
 
-TEST(RosParams, ShippedYamlHasEveryParameterAndLoadsInTheCore) {
+TEST(RosParams, ShippedYamlHasEveryParameterAtItsDefaultUnderTheOneName) {
   const std::string path = std::string(LSF_SOURCE_DIR) + "/config/fusion.yaml";
   lsf::FusionParams loaded;
   ASSERT_NO_THROW(lsf::loadParamsYaml(path, loaded));
   EXPECT_EQ(lsf::ros_params::describeChanges(lsf::FusionParams(), loaded), "")
-      << "config/fusion.yaml documents the paper's values, which are the struct defaults";
+      << "config/fusion.yaml documents the struct defaults";
   cv::FileStorage fs = openRosparamYaml(path);
   ASSERT_TRUE(fs.isOpened());
-  for (const auto& info : lsf::ros_params::listParams()) {
-    const auto slash = info.ros_name.find('/');
-    const cv::FileNode node =
-        slash == std::string::npos
-            ? fs[info.ros_name]
-            : fs[info.ros_name.substr(0, slash)][info.ros_name.substr(slash + 1)];
-    EXPECT_FALSE(node.empty()) << info.ros_name << " is missing from config/fusion.yaml";
+  std::set<std::string> keys;
+  for (const cv::FileNode& node : fs.root()) keys.insert(node.name());
+  std::set<std::string> names;
+  for (const auto& info : lsf::ros_params::listParams()) names.insert(info.name);
+  EXPECT_EQ(keys, names) << "config/fusion.yaml: exactly the table's names, no sections";
+}
+
+TEST(RosParams, ReadmeTableListsEveryParameterOnceUnderItsGroup) {
+  std::ifstream in(std::string(LSF_SOURCE_DIR) + "/README.md");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string readme = text.str();
+  // The algorithm table: rows "| group | `name`, `name` | ... |" between its header and the
+  // paper-preset paragraph.
+  const auto start = readme.find("| group | parameter | default | meaning |");
+  ASSERT_NE(start, std::string::npos);
+  const auto end = readme.find("\n\n", start);
+  std::map<std::string, int> seen;
+  std::map<std::string, std::string> group_of;
+  std::istringstream rows(readme.substr(start, end - start));
+  std::string row;
+  while (std::getline(rows, row)) {
+    std::vector<std::string> cells;
+    std::istringstream split(row);
+    for (std::string c; std::getline(split, c, '|');) {
+      const auto first = c.find_first_not_of(' '), last = c.find_last_not_of(' ');
+      cells.push_back(first == std::string::npos ? "" : c.substr(first, last - first + 1));
+    }
+    if (cells.size() < 4 || cells[1] == "group" || cells[1].rfind("---", 0) == 0) continue;
+    const std::string group = cells[1], cell = cells[2];
+    for (size_t i = cell.find('`'); i != std::string::npos; i = cell.find('`', i + 1)) {
+      const size_t j = cell.find('`', i + 1);
+      if (j == std::string::npos) break;
+      const std::string name = cell.substr(i + 1, j - i - 1);
+      ++seen[name];
+      group_of[name] = group;
+      i = j;
+    }
   }
+  for (const auto& info : lsf::ros_params::listParams()) {
+    EXPECT_EQ(seen[info.name], 1) << info.name << " in README.md's parameter table";
+    EXPECT_EQ(group_of[info.name], info.group) << info.name << ": group in README.md";
+  }
+  EXPECT_EQ(seen.size(), lsf::ros_params::listParams().size()) << "README.md lists other names";
 }

@@ -32,6 +32,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "child_process.h"
 #include "synthetic_input.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -41,102 +42,12 @@ namespace {
 constexpr int kScreenWidth = 1600, kScreenHeight = 1000;
 const cv::Vec3b kBackground(48, 48, 48);  ///< Global Options / Background Color of fusion.rviz
 
-bool waitFor(double timeout, const std::function<bool()>& condition) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout);
-  while (std::chrono::steady_clock::now() < end) {
-    if (condition()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return condition();
-}
-
-/// A child process with its output in a log file; terminated (by its pid) on destruction.
-class Child {
- public:
-  Child(const std::vector<std::string>& argv, const std::string& display, const std::string& log) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (fd >= 0) {
-        dup2(fd, STDOUT_FILENO);
-        dup2(fd, STDERR_FILENO);
-      }
-      if (!display.empty()) setenv("DISPLAY", display.c_str(), 1);
-      std::vector<char*> args;
-      for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-      args.push_back(nullptr);
-      execvp(args[0], args.data());
-      _exit(127);
-    }
-  }
-  ~Child() { stop(); }
-  bool running() {
-    if (pid_ <= 0) return false;
-    int status = 0;
-    if (waitpid(pid_, &status, WNOHANG) == pid_) {
-      pid_ = -1;
-      exit_status_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-      return false;
-    }
-    return true;
-  }
-  int exitStatus() const { return exit_status_; }
-  void stop() {
-    if (!running()) return;
-    kill(pid_, SIGTERM);
-    if (!waitFor(5.0, [&] { return !running(); })) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-    pid_ = -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-  int exit_status_ = -1;
-};
-
-/// Runs a command to completion; returns its exit status.
-int run(const std::vector<std::string>& argv, const std::string& display) {
-  Child child(argv, display, "/dev/null");
-  if (!waitFor(30.0, [&] { return !child.running(); })) return -1;
-  return child.exitStatus();
-}
-
-bool onPath(const std::string& program) {
-  const char* path = std::getenv("PATH");
-  std::string dirs = path ? path : "";
-  std::size_t start = 0;
-  while (start <= dirs.size()) {
-    const std::size_t end = std::min(dirs.find(':', start), dirs.size());
-    const std::string candidate = dirs.substr(start, end - start) + "/" + program;
-    if (access(candidate.c_str(), X_OK) == 0) return true;
-    start = end + 1;
-  }
-  return false;
-}
-
-/// A display number no X server uses.
-int freeDisplay() {
-  for (int n = 90 + static_cast<int>(getpid() % 50); n < 400; ++n) {
-    const std::string lock = "/tmp/.X" + std::to_string(n) + "-lock";
-    const std::string socket = "/tmp/.X11-unix/X" + std::to_string(n);
-    if (access(lock.c_str(), F_OK) != 0 && access(socket.c_str(), F_OK) != 0) return n;
-  }
-  return -1;
-}
-
-/// True when some node subscribes to `topic` (asks the master).
-bool hasSubscriber(const std::string& topic) {
-  XmlRpc::XmlRpcValue request, response, payload;
-  request[0] = ros::this_node::getName();
-  if (!ros::master::execute("getSystemState", request, response, payload, true)) return false;
-  const XmlRpc::XmlRpcValue& subscribers = payload[1];
-  for (int i = 0; i < subscribers.size(); ++i) {
-    if (static_cast<std::string>(subscribers[i][0]) == topic) return true;
-  }
-  return false;
-}
+using lsf::test::Child;
+using lsf::test::freeDisplay;
+using lsf::test::hasSubscriber;
+using lsf::test::onPath;
+using lsf::test::run;
+using lsf::test::waitFor;
 
 /// Publishes frame 0 of the street at 2 Hz from a thread; the sweep stamp offset can change.
 class Publisher {

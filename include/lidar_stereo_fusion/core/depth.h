@@ -30,4 +30,17 @@ struct ColoredPoint {
 std::vector<ColoredPoint> makeColoredCloud(const cv::Mat1f& depth, const cv::Mat& image,
                                            const StereoCamera& camera, int stride = 1);
 
+/// An organised cloud: point (u, v) of the grid is at points[v * width + u].
+struct OrganizedCloud {
+  int width = 0, height = 0;
+  std::vector<ColoredPoint> points;
+};
+
+/// As makeColoredCloud, but organised like stereo_image_proc's points2: a ceil(H / stride) x
+/// ceil(W / stride) grid whose point (u, v) is the back-projection of depth pixel
+/// (u * stride, v * stride); x, y, z are NaN where that pixel has no depth (colour is kept).
+/// Throws like makeColoredCloud.
+OrganizedCloud makeOrganizedCloud(const cv::Mat1f& depth, const cv::Mat& image,
+                                  const StereoCamera& camera, int stride = 1);
+
 }  // namespace lidar_stereo_fusion

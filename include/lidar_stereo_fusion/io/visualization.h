@@ -1,7 +1,10 @@
 // Pictures a person can look at: colourised disparity / depth / error maps. ROS-free.
 #pragma once
 
+#include <string>
+
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 
@@ -22,6 +25,15 @@ cv::Mat colorizeError(const cv::Mat1f& estimate, const cv::Mat1f& reference,
 /// Colourises the prior's confidence [0, 1] (VIRIDIS: dark violet = 0, yellow = 1) where `prior`
 /// has a value; black where it has none (confidence 0 by definition). Returns BGR8.
 cv::Mat colorizeConfidence(const cv::Mat1f& confidence, const cv::Mat1f& prior);
+
+/// `picture` (BGR8) with a colour bar below it, so that its colours can be read as values: the
+/// colour map `colormap` from level 0 (left) to 255 (right), labelled at five places with the
+/// value that level stands for (`value_at_0` .. `value_at_255`, linear) and `unit` ("m", "px").
+/// The colorize* functions above map: disparity 0 .. max -> 0 .. 255 (TURBO), depth max .. 0 m ->
+/// 0 .. 255 (TURBO), error 0 .. max px -> 0 .. 255 (TURBO), confidence 0 .. 1 -> 0 .. 255
+/// (VIRIDIS). Black, as in the picture, means no value.
+cv::Mat withColorBar(const cv::Mat& picture, double value_at_0, double value_at_255,
+                     const std::string& unit, int colormap = cv::COLORMAP_TURBO);
 
 /// Draws sparse LiDAR disparity as coloured dots over a darkened copy of `image`. Returns BGR8.
 cv::Mat overlaySparse(const cv::Mat& image, const cv::Mat1f& sparse, double max_disparity = 0.0);

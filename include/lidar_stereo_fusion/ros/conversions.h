@@ -83,8 +83,9 @@ CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg);
 sensor_msgs::PointCloud2 cloudToMsg(const LidarCloud& cloud, const std_msgs::Header& header);
 
 /// Disparity [px] (0 = no value) as stereo_msgs/DisparityImage filled as stereo_image_proc does:
-/// f = fx [px], T = baseline [m], min/max_disparity = the search range widened to the values
-/// present, delta_d = the nominal sub-pixel step, valid_window = bounding box of valid pixels.
+/// f = fx [px], T = baseline [m], min/max_disparity = the configured search range [min_search,
+/// max_search] (values outside it, NaN included, become 0 = no value), delta_d = the nominal
+/// sub-pixel step, valid_window = bounding box of valid pixels.
 stereo_msgs::DisparityImagePtr disparityToMsg(const cv::Mat1f& disparity,
                                               const std_msgs::Header& header,
                                               const StereoCamera& camera, double min_search,
@@ -95,12 +96,17 @@ stereo_msgs::DisparityImagePtr disparityToMsg(const cv::Mat1f& disparity,
 sensor_msgs::ImagePtr depthToMsg(const cv::Mat1f& depth, const std_msgs::Header& header,
                                  double max_depth = 0.0);
 
+/// A BGR8 picture (CV_8UC3) as a bgr8 image (copied).
+sensor_msgs::ImagePtr bgrImageToMsg(const cv::Mat& image, const std_msgs::Header& header);
+
 /// A float map as a 32FC1 image, unchanged (e.g. the LiDAR prior: disparity [px], 0 = empty).
 sensor_msgs::ImagePtr floatImageToMsg(const cv::Mat1f& image, const std_msgs::Header& header);
 
 /// Coloured points (left optical frame [m]) as PointCloud2 with float32 x, y, z and rgb packed as
-/// in PCL / depth_image_proc (0x00RRGGBB in the bytes of a float32). Unorganised, dense.
-sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const std::vector<ColoredPoint>& points,
+/// in PCL / depth_image_proc (0x00RRGGBB in the bytes of a float32). Organised (height x width as
+/// the grid, point (u, v) at row v, column u) like stereo_image_proc's points2; NaN x, y, z = no
+/// value, so is_dense is false unless every point has one.
+sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const OrganizedCloud& cloud,
                                               const std_msgs::Header& header);
 
 }  // namespace conversions

@@ -28,6 +28,7 @@
 #include <boost/optional.hpp>
 
 #include "lidar_stereo_fusion/ros/frame_matcher.h"
+#include "lidar_stereo_fusion/ros/input_watch.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 
 namespace lidar_stereo_fusion {
@@ -120,6 +121,8 @@ class InputGate {
   std::shared_ptr<message_filters::Synchronizer<ApproxPolicy>> approx_sync_;
   ros::Subscriber sub_cloud_;
   std::atomic<bool> subscribed_{false};
+  InputWatch watch_;  ///< names silent inputs (its own lock)
+  ros::WallTimer watch_timer_;
 
   std::mutex mutex_;  ///< the one lock
   std::condition_variable ready_cv_;

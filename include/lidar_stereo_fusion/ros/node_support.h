@@ -32,9 +32,12 @@ struct NodeParams {
   int num_rings = 64;             ///< beams of the LiDAR (ring recovery; see ensureRings)
   int cloud_stride = 1;           ///< points2 keeps every k-th pixel in rows and columns
   double max_output_depth = 0.0;  ///< [m] depth / points2 beyond this are empty (0 = no limit)
+  double depth_color_max = 80.0;  ///< [m] depth/image_color: the far end of the colour scale
   /// [Hz] image sets stamped closer than 0.9 / max_rate after the last accepted one are dropped on
   /// arrival, counted (FusionStats.rate_limited) and not warned about. 0 = no limit.
   double max_rate = 0.0;
+  /// [s] wall time after which an input topic that sent nothing is warned about, by name (0 = off).
+  double input_timeout = 5.0;
   /// Nice increment of the worker thread (and so of the OpenMP threads it starts): the pipeline
   /// uses every core, and ROS callbacks, nodelet bond heartbeats and drivers in the same machine
   /// must still be served on time. 0 = same priority as the callbacks.

@@ -3,12 +3,13 @@
 // FusionStats once from the core's FrameStats and a snapshot of the counters, and reports
 // diagnostics (output rate, stamps, processing time).
 //
-// Outputs (relative to the node handle): disparity (stereo_msgs/DisparityImage), depth +
-// depth/camera_info (32FC1 [m], NaN = none), points2 (x, y, z, rgb), lidar_disparity (the
-// up-sampled prior, 32FC1 [px], 0 = empty), disparity_image (32FC1 [px], 0 = none, for RViz),
-// confidence (32FC1 in [0, 1], the prior's confidence, 0 = no prior; all 0 for methods without
-// LiDAR), stats (lidar_stereo_fusion/FusionStats), plus /diagnostics. Every output is in the left
-// optical frame and stamped with the left image stamp.
+// Outputs (relative to the node handle): disparity (stereo_msgs/DisparityImage), depth/image_rect +
+// depth/camera_info (32FC1 [m], NaN = none), points2 (x, y, z, rgb, organised H x W, NaN = none),
+// depth/image_color (bgr8, the depth coloured with a scale bar in metres, for RViz),
+// lidar_disparity (the up-sampled prior, 32FC1 [px], 0 = empty), disparity_image (32FC1 [px], 0 =
+// none, for RViz), confidence (32FC1 in [0, 1], the prior's confidence, 0 = no prior; all 0 for
+// methods without LiDAR), stats (lidar_stereo_fusion/FusionStats), plus /diagnostics. Every output
+// is in the left optical frame and stamped with the left image stamp.
 //
 // One lock (mutex_): the subscription state (serialising the gate's subscribe / unsubscribe) and
 // the windows of recent processing times.
@@ -83,21 +84,20 @@ class OutputPublisher {
 
   std::shared_ptr<image_transport::ImageTransport> it_;
   ros::Publisher pub_disparity_, pub_points_, pub_stats_;
-  // depth + depth/camera_info: not an image_transport CameraPublisher, which would put the info
-  // next to the image (camera_info), not under it.
-  image_transport::Publisher pub_depth_;
-  ros::Publisher pub_depth_info_;
+  image_transport::CameraPublisher pub_depth_;  ///< depth/image_rect + depth/camera_info
+  image_transport::Publisher pub_depth_color_;  ///< depth/image_color
   image_transport::Publisher pub_lidar_disparity_, pub_disparity_image_, pub_confidence_;
 
   diagnostic_updater::Updater updater_;
   diagnostic_updater::FrequencyStatus output_frequency_;
   diagnostic_updater::TimeStampStatus output_stamps_;
-  ros::Timer diag_timer_;
+  ros::WallTimer diag_timer_;
 
   std::mutex mutex_;  ///< the one lock
   bool shut_down_ = false;
   std::deque<double> recent_total_ms_, recent_latency_ms_;
   uint32_t diag_last_problems_ = 0;
+  uint32_t diag_clock_epoch_ = 0;  ///< diagnostics thread only
 };
 
 }  // namespace lidar_stereo_fusion

@@ -1,0 +1,48 @@
+// The launch files' arguments as a user meets them (issue 10), read with `roslaunch --dump-params`
+// (no master needed): fusion.launch's `method` does not shadow the params_file unless given;
+// zed_vls128.launch sets use_sim_time false and tells the fusion which drivers it started.
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "run_command.h"
+
+namespace lt = lidar_stereo_fusion::test;
+
+namespace {
+
+/// The parameters roslaunch would set, as its YAML-like dump.
+std::string dumpParams(const std::string& launch, const std::string& args = "") {
+  const auto [status, output] =
+      lt::runCommand("/usr/bin/python3 /usr/bin/roslaunch --dump-params " +
+                     std::string(LSF_SOURCE_DIR) + "/launch/" + launch + " " + args);
+  EXPECT_EQ(status, 0) << output;
+  return output;
+}
+
+}  // namespace
+
+TEST(LaunchFiles, MethodArgumentDoesNotShadowTheParamsFile) {
+  const std::string yaml = std::string(LSF_BINARY_DIR) + "/test_launch_lidar_bi.yaml";
+  std::ofstream(yaml) << "method: lidar_bi\n";
+  const std::string from_file = dumpParams("fusion.launch", "params_file:=" + yaml);
+  EXPECT_NE(from_file.find("/fusion/fusion/method: lidar_bi"), std::string::npos) << from_file;
+  const std::string given = dumpParams("fusion.launch", "params_file:=" + yaml + " method:=pms");
+  EXPECT_NE(given.find("/fusion/fusion/method: pms"), std::string::npos) << given;
+  const std::string playback =
+      dumpParams("playback.launch", "bag:=/nonexistent.bag params_file:=" + yaml);
+  EXPECT_NE(playback.find("/fusion/fusion/method: lidar_bi"), std::string::npos) << playback;
+}
+
+TEST(LaunchFiles, RigLaunchUsesWallClockAndNamesTheDrivers) {
+  const std::string rig = dumpParams("zed_vls128.launch");
+  EXPECT_NE(rig.find("/use_sim_time: false"), std::string::npos) << rig;
+  EXPECT_NE(rig.find("/fusion/fusion/drivers: "), std::string::npos) << rig;
+  // (the dump folds long strings over lines)
+  EXPECT_NE(rig.find("ZED (zed_wrapper):"), std::string::npos) << rig;
+  EXPECT_NE(rig.find("(velodyne_pointcloud):"), std::string::npos) << rig;
+  const std::string without = dumpParams("zed_vls128.launch", "start_zed:=false");
+  EXPECT_EQ(without.find("ZED (zed_wrapper): started"), std::string::npos) << without;
+}
