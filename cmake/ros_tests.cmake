@@ -60,9 +60,10 @@ add_rostest(test/ros/rviz_screenshot.test DEPENDENCIES test_rviz_screenshot)
 lsf_add_ros_test_node(synthetic_publisher test/ros/synthetic_publisher.cpp)
 lsf_add_ros_test_node(measure_fusion test/ros/measure_fusion.cpp)
 
-# Launch files (tools' launch files too: their executables must exist).
+# Launch files (tools' launch files too: their executables must exist; measure_live.launch runs
+# the test nodes synthetic_publisher and measure_fusion).
 find_package(roslaunch REQUIRED)
-set(LSF_LAUNCH_CHECK_DEPENDS fusion_node ${PROJECT_NAME}_ros)
+set(LSF_LAUNCH_CHECK_DEPENDS fusion_node ${PROJECT_NAME}_ros synthetic_publisher measure_fusion)
 foreach(tool autoware_calibration_publisher kitti_calibration_publisher)
   if(TARGET ${tool})
     list(APPEND LSF_LAUNCH_CHECK_DEPENDS ${tool})

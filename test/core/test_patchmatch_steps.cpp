@@ -328,6 +328,18 @@ TEST(PatchMatchPostProcessing, ConfidentPriorFillsElseTheBackgroundNeighbour) {
   EXPECT_EQ(disparity(0, 0), 12.f);
 }
 
+TEST(PatchMatchPostProcessing, AFillNeverLeavesTheSearchRange) {
+  lsf::PatchMatchParams p = params3x3();  // max_disparity 192
+  Views v = prepare({uniform(7, 1, 60)}, {uniform(7, 1, 60)}, p);
+  // d = 20 x + 80: 180 px at x = 5, extended to the border pixel 6: 200 px, beyond 192.
+  for (int x = 0; x < 7; ++x) v.left.planes[x] = pm::Plane{20.f, 0.f, 80.f};
+  cv::Mat1f disparity = pm::disparityOf(v.left);
+  cv::Mat1b bad = cv::Mat1b::zeros(1, 7);
+  bad(0, 6) = 255;  // no right neighbour: only the left plane could fill it
+  pm::fillHoles(v.left, bad, 1, 10.f, 0.5f, disparity, 1);
+  EXPECT_EQ(disparity(0, 6), 180.f);  // not 200: the median of its window (pixel 5)
+}
+
 TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {
   lsf::PatchMatchParams p = params3x3();
   p.full_size_unbounded = false;

@@ -115,12 +115,17 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
         xr = x;
         continue;
       }
+      // A neighbour's plane extended to this pixel fills it only inside the search range: at the
+      // image border one side is missing, and a slanted plane extrapolated far can leave it.
       float best = std::numeric_limits<float>::max();
       const int xl = left_good[x];
       const float fx = static_cast<float>(x), fy = static_cast<float>(y);
-      if (xl >= 0) best = std::min(best, v.planes[y * v.width + xl].at(fx, fy));
-      if (xr < v.width) best = std::min(best, v.planes[y * v.width + xr].at(fx, fy));
-      filled(y, x) = best == std::numeric_limits<float>::max() ? 0.f : std::max(0.f, best);
+      for (const int xn : {xl, xr}) {
+        if (xn < 0 || xn >= v.width) continue;
+        const float d = v.planes[y * v.width + xn].at(fx, fy);
+        if (d >= v.d_min && d <= v.d_max) best = std::min(best, d);
+      }
+      filled(y, x) = best == std::numeric_limits<float>::max() ? 0.f : best;
     }
   }
   // Weighted median over the window of each filled pixel (weights exp(-L1 colour / delta)).

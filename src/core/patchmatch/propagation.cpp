@@ -144,9 +144,7 @@ void PlaneSearch::refine(int x, int y, const WindowCache& cache, Rng& rng, Plane
   }
   float dn = 1.f;
   const float fx = static_cast<float>(x), fy = static_cast<float>(y);
-  // With the sub-pixel step, the last halving (to below 2 kMinRefineStep) is its job.
-  const float stop = options_.subpixel ? 2.f * kMinRefineStep : kMinRefineStep;
-  while (dd >= stop) {
+  while (dd >= kMinRefineStep) {
     const float d = best.at(fx, fy) + rng.uniform(-dd, dd);
     Plane candidate{0.f, 0.f, d};
     if (p_.slanted) {
@@ -191,8 +189,14 @@ void PlaneSearch::subpixelStep(int x, int y, const WindowCache& cache, Plane& be
     }
     return;
   }
-  const float t = 0.5f * h * (c_lower - c_upper) / curvature;
-  if (std::abs(t) < h) tryPlane(x, y, Plane{best.a, best.b, best.c + t}, cache, best, best_cost);
+  // The vertex on a grid of h / 8: a continuous shift would move every plane with the slightest
+  // change of the input (e.g. a calibration rounded to a unit quaternion), and each moved plane
+  // can tip a later comparison; on the grid almost all stay where they were.
+  const float quantum = h / 8.f;
+  const float t = quantum * std::round(0.5f * h * (c_lower - c_upper) / curvature / quantum);
+  if (t != 0.f && std::abs(t) < h) {
+    tryPlane(x, y, Plane{best.a, best.b, best.c + t}, cache, best, best_cost);
+  }
 }
 
 int threadCount(const PatchMatchParams& p) {

@@ -70,7 +70,7 @@ class PlaneSearch {
   float currentCost(int idx, const WindowCache& cache) const;
 
   /// Plane refinement (random perturbations of d and n, halving ranges), then subpixelStep()
-  /// when the options ask for it (which replaces the last halving).
+  /// when the options ask for it.
   void refine(int x, int y, const WindowCache& cache, Rng& rng, Plane& best,
               float& best_cost) const;
 
