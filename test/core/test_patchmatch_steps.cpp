@@ -322,22 +322,25 @@ TEST(PatchMatchPostProcessing, ConfidentPriorFillsElseTheBackgroundNeighbour) {
   cv::Mat1f disparity = pm::disparityOf(v.left);
   cv::Mat1b bad = cv::Mat1b::zeros(1, 7);
   bad(0, 2) = bad(0, 4) = 255;
-  pm::fillHoles(v.left, bad, 1, 10.f, 0.5f, disparity, 1);
+  pm::fillHoles(v.left, bad, 1, 10.f, 0.5f, 192.f, disparity, 1);
   EXPECT_EQ(disparity(0, 2), 9.f);  // the prior
   EXPECT_EQ(disparity(0, 4), 3.f);  // min(12 from the left, 3 from the right): the background
   EXPECT_EQ(disparity(0, 0), 12.f);
 }
 
-TEST(PatchMatchPostProcessing, AFillNeverLeavesTheSearchRange) {
-  lsf::PatchMatchParams p = params3x3();  // max_disparity 192
-  Views v = prepare({uniform(7, 1, 60)}, {uniform(7, 1, 60)}, p);
-  // d = 20 x + 80: 180 px at x = 5, extended to the border pixel 6: 200 px, beyond 192.
-  for (int x = 0; x < 7; ++x) v.left.planes[x] = pm::Plane{20.f, 0.f, 80.f};
+TEST(PatchMatchPostProcessing, AFillNeverPassesTheSearchRange) {
+  lsf::PatchMatchParams p = params3x3();
+  Views v = prepare({uniform(9, 1, 60)}, {uniform(9, 1, 60)}, p);
+  // d = 20 x + 80 on pixels 0..4 (160 px at x = 4); pixels 5..8 failed the check and have no
+  // right neighbour: pixel 4's plane reaches 180, 200, 220, 240 px there, beyond 192 from x = 6.
+  for (int x = 0; x < 9; ++x) v.left.planes[x] = pm::Plane{20.f, 0.f, 80.f};
   cv::Mat1f disparity = pm::disparityOf(v.left);
-  cv::Mat1b bad = cv::Mat1b::zeros(1, 7);
-  bad(0, 6) = 255;  // no right neighbour: only the left plane could fill it
-  pm::fillHoles(v.left, bad, 1, 10.f, 0.5f, disparity, 1);
-  EXPECT_EQ(disparity(0, 6), 180.f);  // not 200: the median of its window (pixel 5)
+  cv::Mat1b bad = cv::Mat1b::zeros(1, 9);
+  for (int x = 5; x < 9; ++x) bad(0, x) = 255;
+  pm::fillHoles(v.left, bad, 2, 10.f, 0.5f, 192.f, disparity, 1);
+  for (int x = 5; x < 9; ++x) EXPECT_LE(disparity(0, x), 192.f) << x;
+  EXPECT_EQ(disparity(0, 8), 0.f);  // its window (pixels 6, 8) holds no fill: left empty
+  EXPECT_EQ(disparity(0, 5), 140.f);  // the median of its window: pixels 3 (140) and 5 (180)
 }
 
 TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {

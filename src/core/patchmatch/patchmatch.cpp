@@ -165,7 +165,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
         leftRightCheck(result.disparity, result.right_disparity, static_cast<float>(p.lr_max_diff),
                        lockedToPrior(lv), p.confidence_weighting && !lv.prior.empty());
     fillHoles(lv, result.inconsistent.clone(), p.median_radius, static_cast<float>(p.weight_delta),
-              static_cast<float>(p.fill_confidence), result.disparity, threadCount(p));
+              static_cast<float>(p.fill_confidence), static_cast<float>(p.max_disparity),
+              result.disparity, threadCount(p));
   } else {
     result.inconsistent = cv::Mat1b(size, uchar(0));
   }

@@ -87,7 +87,7 @@ cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float ma
 }
 
 void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float fill_trust,
-               cv::Mat1f& disparity, int threads) {
+               float max_disparity, cv::Mat1f& disparity, int threads) {
   if (!v.prior.empty()) {
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (int y = 0; y < v.height; ++y) {
@@ -115,17 +115,17 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
         xr = x;
         continue;
       }
-      // A neighbour's plane extended to this pixel fills it only inside the search range: at the
-      // image border one side is missing, and a slanted plane extrapolated far can leave it.
+      // A neighbour's plane extended to this pixel fills it only up to max_disparity: at the
+      // image border one side is missing, and a slanted plane extrapolated far can pass it.
       float best = std::numeric_limits<float>::max();
       const int xl = left_good[x];
       const float fx = static_cast<float>(x), fy = static_cast<float>(y);
       for (const int xn : {xl, xr}) {
         if (xn < 0 || xn >= v.width) continue;
         const float d = v.planes[y * v.width + xn].at(fx, fy);
-        if (d >= v.d_min && d <= v.d_max) best = std::min(best, d);
+        if (d <= max_disparity) best = std::min(best, d);
       }
-      filled(y, x) = best == std::numeric_limits<float>::max() ? 0.f : best;
+      filled(y, x) = best == std::numeric_limits<float>::max() ? 0.f : std::max(0.f, best);
     }
   }
   // Weighted median over the window of each filled pixel (weights exp(-L1 colour / delta)).

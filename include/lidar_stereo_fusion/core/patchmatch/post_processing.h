@@ -24,11 +24,11 @@ cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float ma
 /// Fills the pixels marked in `bad` (modified). Where the view's prior has a value and its trust
 /// is >= fill_trust, the prior fills the hole (the LiDAR saw the point: our reading for the fused
 /// method; Bleyer's background fill assumes no other source). Elsewhere the lower (background)
-/// disparity of the nearest consistent planes left and right (of those that stay inside the
-/// view's search range [d_min, d_max] at the pixel), then a colour-weighted median over
+/// disparity of the nearest consistent planes left and right (of those not above max_disparity,
+/// the configured search range, at the pixel), then a colour-weighted median over
 /// the window of radius `radius` (every second row and column; weights exp(-L1 colour / delta)).
 void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float fill_trust,
-               cv::Mat1f& disparity, int threads);
+               float max_disparity, cv::Mat1f& disparity, int threads);
 
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion
