@@ -288,7 +288,7 @@ TEST(PatchMatchViewPropagation, OfferedPlanesAreTriedWhenTheSweepVisitsAndTheNea
   const int idx = 10 * 80 + 40;
   ASSERT_TRUE(v.right.offered[idx]);
   EXPECT_EQ(v.right.offer[idx].c, 6.f);
-  EXPECT_EQ(v.right.planes[idx].c, 20.f);  // nothing evaluated yet
+  EXPECT_EQ(v.right.planes[idx].c, 20.f);       // nothing evaluated yet
   EXPECT_FALSE(v.right.offered[10 * 80 + 78]);  // no left pixel maps there
   pm::WindowCache cache;
   right_search.processPixel(40, 10, true, 0, cache);
@@ -339,7 +339,7 @@ TEST(PatchMatchPostProcessing, AFillNeverPassesTheSearchRange) {
   for (int x = 5; x < 9; ++x) bad(0, x) = 255;
   pm::fillHoles(v.left, bad, 2, 10.f, 0.5f, 192.f, disparity, 1);
   for (int x = 5; x < 9; ++x) EXPECT_LE(disparity(0, x), 192.f) << x;
-  EXPECT_EQ(disparity(0, 8), 0.f);  // its window (pixels 6, 8) holds no fill: left empty
+  EXPECT_EQ(disparity(0, 8), 0.f);    // its window (pixels 6, 8) holds no fill: left empty
   EXPECT_EQ(disparity(0, 5), 140.f);  // the median of its window: pixels 3 (140) and 5 (180)
 }
 
