@@ -23,8 +23,23 @@ export PATH=/usr/bin:/bin:$PATH
 export ROS_HOME=${ROS_HOME:-$WS/ros_home}
 export ROS_LOG_DIR=${ROS_LOG_DIR:-$WS/ros_home/log}
 
+# The package in the workspace is a folder of links to the repository's top-level entries, not a
+# link to the repository itself: with the workspace inside the repository (the default), such a
+# link is a loop, and tools that walk the package folder (roslaunch looking for playback.launch)
+# find the file again under ws/src/lidar_stereo_fusion/ws/src/... and refuse it as ambiguous.
+PKG="$WS/src/lidar_stereo_fusion"
 mkdir -p "$WS/src"
-ln -sfn "$ROOT" "$WS/src/lidar_stereo_fusion"
+if [ -L "$PKG" ]; then rm "$PKG"; fi
+mkdir -p "$PKG"
+for entry in "$ROOT"/* "$ROOT"/.[!.]*; do
+  [ -e "$entry" ] || continue
+  name=$(basename "$entry")
+  if [ "$name" = .git ] || [ "$entry" -ef "$WS" ]; then continue; fi
+  ln -sfn "$entry" "$PKG/$name"
+done
+for link in "$PKG"/* "$PKG"/.[!.]*; do  # entries removed from the repository
+  if [ -L "$link" ] && [ ! -e "$link" ]; then rm "$link"; fi
+done
 cd "$WS"
 # Both Python variables: Debian's pluginlib looks Python up again with find_package(Python3).
 CMAKE_ARGS=(-DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3
