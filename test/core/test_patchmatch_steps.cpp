@@ -35,6 +35,13 @@ struct Views {
   pm::ViewState left, right;
 };
 
+/// A view searched by propagation alone (no plane refinement).
+pm::SearchOptions propagationOnly() {
+  pm::SearchOptions o;
+  o.refine = false;
+  return o;
+}
+
 Views prepare(const lsf::ViewInput& l, const lsf::ViewInput& r, const lsf::PatchMatchParams& p) {
   Views v;
   pm::prepareView(l, p, -1.f, v.left);
@@ -229,11 +236,9 @@ TEST(PatchMatchSearch, WithoutRefinementAPixelOnlyTakesItsNeighboursPlane) {
   lsf::PatchMatchParams p = params3x3();
   p.window_radius = 3;
   Views v = prepare({s.left}, {s.right}, p);
-  pm::SearchOptions propagation_only;
-  propagation_only.refine = false;
   for (const bool refine : {false, true}) {
     const pm::PlaneSearch search(p, v.left, v.right,
-                                 refine ? pm::SearchOptions() : propagation_only);
+                                 refine ? pm::SearchOptions() : propagationOnly());
     const int idx = 15 * 80 + 40;
     v.left.planes[idx] = pm::Plane{0.f, 0.f, 7.f};
     v.left.cost[idx] = pm::kUnknownCost;
@@ -274,9 +279,7 @@ TEST(PatchMatchViewPropagation, OfferedPlanesAreTriedWhenTheSweepVisitsAndTheNea
   lsf::PatchMatchParams p = params3x3();
   p.window_radius = 2;
   Views v = prepare({s.left}, {s.right}, p);
-  pm::SearchOptions propagation_only;
-  propagation_only.refine = false;
-  const pm::PlaneSearch right_search(p, v.right, v.left, propagation_only);
+  const pm::PlaneSearch right_search(p, v.right, v.left, propagationOnly());
   for (auto& plane : v.left.planes) plane = pm::Plane{0.f, 0.f, 6.f};
   // Left pixel 44 (d 4) and left pixel 46 (d 6) both match right pixel 40: 46 is the nearer.
   v.left.planes[10 * 80 + 44] = pm::Plane{0.f, 0.f, 4.f};

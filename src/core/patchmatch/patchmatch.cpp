@@ -34,9 +34,9 @@ std::vector<uint8_t> lockedToPrior(const patchmatch::ViewState& v) {
   return keep;
 }
 
-cv::Mat3f planeMap(const patchmatch::ViewState& v) {
+cv::Mat3f planeMap(const patchmatch::ViewState& v, int threads) {
   cv::Mat3f map(v.height, v.width);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
     for (int x = 0; x < v.width; ++x) {
       const patchmatch::Plane& pl = v.planes[y * v.width + x];
@@ -154,19 +154,20 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   }
 
   PatchMatchResult result;
-  result.disparity = disparityOf(lv);
-  result.planes = planeMap(lv);
+  const int threads = threadCount(p);
+  result.disparity = disparityOf(lv, threads);
+  result.planes = planeMap(lv, threads);
   if (two_views) {
-    result.right_disparity = disparityOf(rv);
-    result.right_planes = planeMap(rv);
+    result.right_disparity = disparityOf(rv, threads);
+    result.right_planes = planeMap(rv, threads);
   }
   if (p.lr_check) {
     result.inconsistent =
         leftRightCheck(result.disparity, result.right_disparity, static_cast<float>(p.lr_max_diff),
-                       lockedToPrior(lv), p.confidence_weighting && !lv.prior.empty());
+                       lockedToPrior(lv), p.confidence_weighting && !lv.prior.empty(), threads);
     fillHoles(lv, result.inconsistent.clone(), p.median_radius, static_cast<float>(p.weight_delta),
               static_cast<float>(p.fill_confidence), static_cast<float>(p.max_disparity),
-              result.disparity, threadCount(p));
+              result.disparity, threads);
   } else {
     result.inconsistent = cv::Mat1b(size, uchar(0));
   }

@@ -56,9 +56,9 @@ float weightedMedian(float* d, float* w, int n, float half) {
 
 }  // namespace
 
-cv::Mat1f disparityOf(const ViewState& v) {
+cv::Mat1f disparityOf(const ViewState& v, int threads) {
   cv::Mat1f d(v.height, v.width);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
     for (int x = 0; x < v.width; ++x) {
       d(y, x) = v.planes[y * v.width + x].at(static_cast<float>(x), static_cast<float>(y));
@@ -68,9 +68,9 @@ cv::Mat1f disparityOf(const ViewState& v) {
 }
 
 cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float max_diff,
-                         const std::vector<uint8_t>& keep, bool unmatched_bad) {
+                         const std::vector<uint8_t>& keep, bool unmatched_bad, int threads) {
   cv::Mat1b bad(left.size(), uchar(0));
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads)
   for (int y = 0; y < left.rows; ++y) {
     for (int x = 0; x < left.cols; ++x) {
       if (!keep.empty() && keep[y * left.cols + x]) continue;

@@ -11,7 +11,8 @@ namespace lidar_stereo_fusion {
 namespace patchmatch {
 
 /// Disparity of every pixel's plane at the pixel [px].
-cv::Mat1f disparityOf(const ViewState& v);
+/// Rows run on `threads` threads.
+cv::Mat1f disparityOf(const ViewState& v, int threads = 1);
 
 /// Left-right check: 255 where the left disparity and the right disparity at its match
 /// (x - round(d)) differ by more than max_diff [px]. A pixel whose match falls outside the right
@@ -19,7 +20,8 @@ cv::Mat1f disparityOf(const ViewState& v);
 /// `unmatched_bad` (the fused method: stereo cannot see there, the LiDAR fill can). Pixels in
 /// `keep` (locked pixels, which the LiDAR measured; may be empty()) are always kept.
 cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float max_diff,
-                         const std::vector<uint8_t>& keep, bool unmatched_bad = false);
+                         const std::vector<uint8_t>& keep, bool unmatched_bad = false,
+                         int threads = 1);
 
 /// Fills the pixels marked in `bad` (modified). Where the view's prior has a value and its trust
 /// is >= fill_trust, the prior fills the hole (the LiDAR saw the point: our reading for the fused
