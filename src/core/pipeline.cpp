@@ -106,6 +106,7 @@ PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
   base.window_stride = 3;
   base.window_dyadic = false;
   base.median_radius = 17;
+  base.iterations = 3;  // Bleyer's
   base.right_iterations = -1;
   base.init_from_prior = false;
   base.use_lidar_bounds = false;

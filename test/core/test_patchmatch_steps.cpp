@@ -255,6 +255,29 @@ TEST(PatchMatchSearch, WithoutRefinementAPixelOnlyTakesItsNeighboursPlane) {
   }
 }
 
+TEST(PatchMatchSearch, PolishWithoutRefinementStepsDOnlyAndKeepsTheNormal) {
+  // fine_refine: false at full size: propagation, then the sub-pixel step alone.
+  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(80, 30, 0.0, 0.0, 9.0, 5);
+  lsf::PatchMatchParams p = params3x3();
+  p.window_radius = 3;
+  Views v = prepare({s.left}, {s.right}, p);
+  pm::SearchOptions polish = propagationOnly();
+  polish.subpixel = true;
+  const pm::PlaneSearch search(p, v.left, v.right, polish);
+  const int idx = 15 * 80 + 40;
+  v.left.planes[idx] = pm::Plane{0.f, 0.f, 7.f};
+  v.left.cost[idx] = pm::kUnknownCost;
+  v.left.planes[idx - 1] = pm::Plane{0.f, 0.f, 9.06f};  // the neighbour is 0.06 px off
+  v.left.planes[idx - 80] = pm::Plane{0.f, 0.f, 7.f};
+  pm::WindowCache cache;
+  search.processPixel(40, 15, true, 0, cache);
+  const pm::Plane& got = v.left.planes[idx];
+  EXPECT_LT(std::abs(got.c - 9.f), 0.6f * 0.06f);  // taken from the neighbour, then stepped
+  EXPECT_NE(got.c, 9.06f);
+  EXPECT_EQ(got.a, 0.f);  // no random refinement: the normal is the neighbour's
+  EXPECT_EQ(got.b, 0.f);
+}
+
 TEST(PatchMatchViewPropagation, AGoodLeftPlaneReachesItsMatchInTheRightView) {
   const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(80, 20, 0.0, 0.0, 6.0, 9);
   lsf::PatchMatchParams p = params3x3();

@@ -90,6 +90,7 @@ void visitParamTable(P& p, V&& v) {
   v(ParamName{"fine_refine_range", pm}, m.fine_refine_range);
   v(ParamName{"fine_right_view", pm}, m.fine_right_view);
   v(ParamName{"fine_subpixel", pm}, m.fine_subpixel);
+  v(ParamName{"fine_refine", pm}, m.fine_refine);
   v(ParamName{"num_threads", pm}, m.num_threads);
   v(ParamName{"seed", pm}, m.seed);
 }

@@ -6,8 +6,9 @@
 // Per iteration: left view sweep. In the last `right_iterations` iterations also: view
 // propagation of the left planes into the right view, right view sweep, view propagation back
 // into the left. Then the left-right check and filling. At the full-size level after a coarse
-// start, the right view sweeps by propagation alone (fine_right_view) and the left view ends each
-// pixel's refinement with a sub-pixel step (fine_subpixel).
+// start, the right view sweeps by propagation alone (fine_right_view) and the left view polishes
+// each pixel's plane with a sub-pixel step (fine_subpixel), after a random refinement only if
+// fine_refine.
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -122,10 +123,11 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   }
 
   // The full-size level after a coarse start polishes the planes it was given: the left view
-  // with a sub-pixel step after refinement; the right view, which serves view propagation and
+  // with a sub-pixel step (after random refinement if fine_refine); the right view, which serves view propagation and
   // the left-right check, by propagation alone unless fine_right_view.
   SearchOptions left_options, right_options;
   left_options.subpixel = guided && p.fine_subpixel;
+  left_options.refine = !guided || p.fine_refine;
   right_options.refine = !guided || p.fine_right_view;
   PlaneSearch left_search(p, lv, rv, left_options);
   PlaneSearch right_search(p, rv, lv, right_options);

@@ -96,6 +96,8 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   if (options_.refine) {
     Rng rng(streamKey(p_.seed, self_.match_sign < 0 ? 0 : 1, iteration, idx));
     refine(x, y, cache, rng, best, best_cost);
+  } else if (options_.subpixel) {
+    subpixelStep(x, y, cache, best, best_cost);
   }
   self_.planes[idx] = best;
   self_.cost[idx] = best_cost;
@@ -105,8 +107,12 @@ void PlaneSearch::polishSettled(int x, int y, int idx, int iteration, WindowCach
   cost_.buildWindow(x, y, cache);
   Plane best = self_.planes[idx];
   float best_cost = currentCost(idx, cache);
-  Rng rng(streamKey(p_.seed, 0, iteration, idx));
-  refine(x, y, cache, rng, best, best_cost);  // from +-fine_refine_range: the pixel has a guide
+  if (options_.refine) {
+    Rng rng(streamKey(p_.seed, 0, iteration, idx));
+    refine(x, y, cache, rng, best, best_cost);  // from +-fine_refine_range: the pixel has a guide
+  } else if (options_.subpixel) {
+    subpixelStep(x, y, cache, best, best_cost);
+  }
   self_.planes[idx] = best;
   self_.cost[idx] = best_cost;
 }
@@ -177,8 +183,11 @@ void PlaneSearch::subpixelStep(int x, int y, const WindowCache& cache, Plane& be
   const float unbounded = std::numeric_limits<float>::max();  // the fit needs the full costs
   const float c_lower = cost_.aggregate(cache, lower, unbounded);
   const float c_upper = cost_.aggregate(cache, upper, unbounded);
-  const float curvature = c_lower - 2.f * best_cost + c_upper;
-  if (!(curvature > 0.f)) {  // no minimum between the two: keep the cheapest of the three
+  // The steeper side's slope is the V's: rise over h.
+  const float rise = std::max(c_lower, c_upper) - best_cost;
+  const float vertex = rise > 0.f ? 0.5f * h * (c_lower - c_upper) / rise : 0.f;
+  if (!(rise > 0.f) || !(std::abs(vertex) <= h)) {
+    // No V with its vertex between the two: keep the cheapest of the three.
     if (c_lower < best_cost) {
       best = lower;
       best_cost = c_lower;
@@ -193,8 +202,8 @@ void PlaneSearch::subpixelStep(int x, int y, const WindowCache& cache, Plane& be
   // change of the input (e.g. a calibration rounded to a unit quaternion), and each moved plane
   // can tip a later comparison; on the grid almost all stay where they were.
   const float quantum = h / 8.f;
-  const float t = quantum * std::round(0.5f * h * (c_lower - c_upper) / curvature / quantum);
-  if (t != 0.f && std::abs(t) < h) {
+  const float t = quantum * std::round(vertex / quantum);
+  if (t != 0.f) {
     tryPlane(x, y, Plane{best.a, best.b, best.c + t}, cache, best, best_cost);
   }
 }

@@ -5,9 +5,10 @@
 // Readings taken here:
 //  * A plane is accepted for pixel p only if its disparity at p lies in [lo(p), hi(p)] from the
 //    scan lines above and below (plus bound_margin), and always in [d_min, d_max] of the image.
-//  * At the full-size level after a coarse start, d's random refinement ends with a parabolic
-//    sub-pixel step (subpixelStep) in the left view, and the right view is searched by
-//    propagation only (PatchMatchParams::fine_subpixel, fine_right_view).
+//  * At the full-size level after a coarse start, the left view polishes each plane with a
+//    sub-pixel step (subpixelStep), after a random refinement only if fine_refine, and the right
+//    view is searched by propagation only (PatchMatchParams::fine_subpixel, fine_refine,
+//    fine_right_view).
 //  * Refinement starts from Delta_d_max = max(|d_up - d_down|, min_refine_range) between scan
 //    lines (else half the image's disparity range), Delta_n_max = 1; both halve until
 //    Delta_d_max < 0.1 px. At a level that starts from the planes of a coarser one (coarse
@@ -32,8 +33,8 @@ namespace patchmatch {
 
 /// How a level searches one view (the driver decides per level and view, patchmatch.cpp).
 struct SearchOptions {
-  bool refine = true;     ///< plane refinement after spatial propagation (false: propagation only)
-  bool subpixel = false;  ///< refinement ends with subpixelStep()
+  bool refine = true;     ///< random plane refinement after spatial propagation
+  bool subpixel = false;  ///< subpixelStep() ends the pixel's search (after refinement if refine)
 };
 
 class PlaneSearch {
@@ -52,13 +53,14 @@ class PlaneSearch {
   Plane initialPlane(int x, int y, Rng& rng) const;
 
   /// One step of a sweep at (x, y): spatial propagation from the left/upper (forward) or
-  /// right/lower neighbour, then plane refinement. Does nothing on a pixel locked to the prior;
+  /// right/lower neighbour, then plane refinement and/or the sub-pixel step (SearchOptions; with
+  /// neither, propagation only). Does nothing on a pixel locked to the prior;
   /// polishes a pixel settled by the coarse level (polishSettled).
   void processPixel(int x, int y, bool forward, int iteration, WindowCache& cache) const;
 
-  /// Plane refinement alone (no spatial propagation) of a pixel settled by the coarse level, in
-  /// the left view only: its plane comes from a level of half the size, whose refinement stops at
-  /// 0.1 px there (0.2 px here); refinement from +-fine_refine_range restores full-size precision.
+  /// Plane refinement and/or the sub-pixel step alone (no spatial propagation) of a pixel settled
+  /// by the coarse level, in the left view only: its plane comes from a level of half the size,
+  /// whose refinement stops at 0.1 px there (0.2 px here).
   void polishSettled(int x, int y, int idx, int iteration, WindowCache& cache) const;
 
   /// Replaces (best, best_cost) by `candidate` when it is admissible and cheaper.
@@ -74,11 +76,14 @@ class PlaneSearch {
   void refine(int x, int y, const WindowCache& cache, Rng& rng, Plane& best,
               float& best_cost) const;
 
-  /// Sub-pixel step on d with the normal kept: the parabola through the costs of the planes
-  /// shifted by -h, 0 and +h (h = kMinRefineStep, d's last refinement step) has its vertex at
-  /// shift t = h (C(-h) - C(+h)) / (2 (C(-h) - 2 C(0) + C(+h))), rounded to a multiple of h / 8;
-  /// the plane shifted by t (0 < |t| < h) replaces the best if it costs less, or the cheaper of
-  /// +-h where the costs do not curve up.
+  /// Sub-pixel step on d with the normal kept, by equiangular line fitting (Shimizu & Okutomi
+  /// 2001; the costs are sums of absolute differences, V-shaped around their minimum, where a
+  /// parabola's vertex is biased toward the middle sample): for the planes shifted by -h, 0, +h
+  /// (h = kMinRefineStep, d's last refinement step), the steeper side gives the V's slope and the
+  /// two lines of equal and opposite slope meet at
+  ///   t = h (C(-h) - C(+h)) / (2 (max(C(-h), C(+h)) - C(0))),
+  /// rounded to a multiple of h / 8; where |t| <= h the plane shifted by t replaces the best if it
+  /// costs less, elsewhere (no V with its vertex between -h and +h) the cheapest of the three.
   void subpixelStep(int x, int y, const WindowCache& cache, Plane& best, float& best_cost) const;
 
  private:
