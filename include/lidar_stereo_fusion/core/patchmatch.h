@@ -77,8 +77,9 @@ struct PatchMatchParams {
   int fine_iterations = 1;
   double fine_refine_range = 1.0;  ///< [px]
   /// Full-size level of a coarse start only: whether the right view's sweep refines planes too
-  /// (Bleyer). false: it propagates planes only; the right view serves view propagation and the
-  /// left-right check, for which the planes of the level below, spread by propagation, suffice.
+  /// (Bleyer). false: it propagates planes only; the right view serves the left-right check, for
+  /// which the planes of the level below, spread by propagation, suffice, and hands no planes
+  /// back to the left view (it would return the left's own or the level below's).
   bool fine_right_view = false;
   /// Full-size level of a coarse start only: a sub-pixel step on the left view's d
   /// (patchmatch/propagation.h), after the random refinement if fine_refine; random refinement

@@ -5,7 +5,7 @@
 //
 // Per iteration: left view sweep. In the last `right_iterations` iterations also: view
 // propagation of the left planes into the right view, right view sweep, view propagation back
-// into the left. Then the left-right check and filling. At the full-size level after a coarse
+// into the left (unless the right view was swept by propagation alone). Then the left-right check and filling. At the full-size level after a coarse
 // start, the right view sweeps by propagation alone (fine_right_view) and the left view polishes
 // each pixel's plane with a sub-pixel step (fine_subpixel), after a random refinement only if
 // fine_refine.
@@ -152,7 +152,10 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
       }
     }
     sweep(right_search, rv, p, it);
-    if (p.view_propagation) propagateView(rv, left_search, lv, p, false);
+    // A right view swept by propagation alone holds the left planes it was offered or the
+    // level below's, which that level's view propagation has handed to the left already: nothing
+    // new to hand back (KITTI and Middlebury unchanged without it, a fifth of the level's work).
+    if (p.view_propagation && right_options.refine) propagateView(rv, left_search, lv, p, false);
   }
 
   PatchMatchResult result;
