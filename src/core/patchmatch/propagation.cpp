@@ -202,9 +202,12 @@ void PlaneSearch::subpixelStep(int x, int y, const WindowCache& cache, Plane& be
   // change of the input (e.g. a calibration rounded to a unit quaternion), and each moved plane
   // can tip a later comparison; on the grid almost all stay where they were.
   const float quantum = h / 8.f;
+  // The vertex is taken without evaluating it (the fit says it is the cheapest; d + t lies
+  // between the two admissible shifts): its cost is computed if ever asked for (currentCost).
   const float t = quantum * std::round(vertex / quantum);
   if (t != 0.f) {
-    tryPlane(x, y, Plane{best.a, best.b, best.c + t}, cache, best, best_cost);
+    best.c += t;
+    best_cost = kUnknownCost;
   }
 }
 

@@ -82,8 +82,9 @@ class PlaneSearch {
   /// (h = kMinRefineStep, d's last refinement step), the steeper side gives the V's slope and the
   /// two lines of equal and opposite slope meet at
   ///   t = h (C(-h) - C(+h)) / (2 (max(C(-h), C(+h)) - C(0))),
-  /// rounded to a multiple of h / 8; where |t| <= h the plane shifted by t replaces the best if it
-  /// costs less, elsewhere (no V with its vertex between -h and +h) the cheapest of the three.
+  /// rounded to a multiple of h / 8; where |t| <= h the plane shifted by t replaces the best,
+  /// unevaluated (best_cost becomes kUnknownCost), elsewhere (no V with its vertex between -h and
+  /// +h) the cheapest of the three.
   void subpixelStep(int x, int y, const WindowCache& cache, Plane& best, float& best_cost) const;
 
  private:
