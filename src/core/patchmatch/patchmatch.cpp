@@ -11,6 +11,7 @@
 // fine_refine.
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <stdexcept>
 #include <string>
 
@@ -102,8 +103,18 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   if (!scratch_) scratch_ = std::make_shared<Scratch>();
   ViewState& lv = scratch_->left;
   ViewState& rv = scratch_->right;
-  prepareView(left, p, -1.f, lv);
-  prepareView(right, p, +1.f, rv);
+  {
+    // The views are independent: the right one is prepared beside the left (its exceptions
+    // reach here through the future, whose destructor waits if the left throws).
+    std::future<void> right_ready;
+    if (threadCount(p) > 1) {
+      right_ready = std::async(std::launch::async, [&] { prepareView(right, p, +1.f, rv); });
+    } else {
+      prepareView(right, p, +1.f, rv);
+    }
+    prepareView(left, p, -1.f, lv);
+    if (right_ready.valid()) right_ready.get();
+  }
   const bool two_views = p.view_propagation || p.lr_check;
 
   int iterations = p.iterations;
@@ -129,6 +140,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   left_options.subpixel = guided && p.fine_subpixel;
   left_options.refine = !guided || p.fine_refine;
   right_options.refine = !guided || p.fine_right_view;
+  // Swept by propagation alone, the right view serves the left-right check only.
+  if (!right_options.refine) right_options.tolerance = 0.25f * static_cast<float>(p.lr_max_diff);
   PlaneSearch left_search(p, lv, rv, left_options);
   PlaneSearch right_search(p, rv, lv, right_options);
   initialise(left_search, lv, p, 0);
@@ -143,12 +156,13 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     sweep(left_search, lv, p, it);
     if (!two_views || it < iterations - right_iterations) continue;
     if (p.view_propagation) {
-      // A right view swept by propagation alone tries the left planes in its sweep, with the
-      // windows the sweep builds anyway; a refined one gets every plane (Bleyer).
-      if (right_options.refine) {
-        propagateView(lv, right_search, rv, p, true);
-      } else {
+      // After a coarse start, the right view tries the left planes in its sweep, with the
+      // windows the sweep builds anyway; Bleyer's view propagation (the coarsest level, the
+      // paper preset, plain PMS) builds one more per pixel, before the sweep.
+      if (guided) {
         offerView(lv, right_search, rv, p, true);
+      } else {
+        propagateView(lv, right_search, rv, p, true);
       }
     }
     sweep(right_search, rv, p, it);

@@ -14,31 +14,34 @@ namespace patchmatch {
 
 namespace {
 
-/// The colour-weighted median of (d[i], w[i]), i < n: the smallest d whose cumulative weight in
+/// A window sample of the weighted median: disparity and weight.
+struct Weighted {
+  float d, w;
+};
+
+/// The colour-weighted median of s[i], i < n: the smallest d whose cumulative weight in
 /// ascending order of d reaches `half` (half the total weight). A three-way quickselect, O(n) on
-/// average; d and w are reordered.
-float weightedMedian(float* d, float* w, int n, float half) {
+/// average; s is reordered.
+float weightedMedian(Weighted* s, int n, float half) {
   int lo = 0, hi = n;  // the answer is among [lo, hi)
-  float pivot = d[0];
+  float pivot = s[0].d;
   while (hi - lo > 1) {
-    const float a = d[lo], b = d[lo + (hi - lo) / 2], c = d[hi - 1];
+    const float a = s[lo].d, b = s[lo + (hi - lo) / 2].d, c = s[hi - 1].d;
     pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));  // median of three
     // [lo, lt) < pivot, [lt, gt) == pivot, [gt, hi) > pivot.
     int lt = lo, i = lo, gt = hi;
     float w_less = 0.f, w_equal = 0.f;
     while (i < gt) {
-      if (d[i] < pivot) {
-        std::swap(d[i], d[lt]);
-        std::swap(w[i], w[lt]);
-        w_less += w[lt];
+      if (s[i].d < pivot) {
+        std::swap(s[i], s[lt]);
+        w_less += s[lt].w;
         ++lt;
         ++i;
-      } else if (d[i] > pivot) {
+      } else if (s[i].d > pivot) {
         --gt;
-        std::swap(d[i], d[gt]);
-        std::swap(w[i], w[gt]);
+        std::swap(s[i], s[gt]);
       } else {
-        w_equal += w[i];
+        w_equal += s[i].w;
         ++i;
       }
     }
@@ -51,7 +54,7 @@ float weightedMedian(float* d, float* w, int n, float half) {
       lo = gt;
     }
   }
-  return hi - lo == 1 ? d[lo] : pivot;
+  return hi - lo == 1 ? s[lo].d : pivot;
 }
 
 }  // namespace
@@ -132,15 +135,15 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
   std::vector<float> lut(1024);
   for (size_t i = 0; i < lut.size(); ++i) lut[i] = std::exp(-static_cast<float>(i) / delta);
   filled.copyTo(disparity);  // same size: no new allocation
+  const int lut_last = static_cast<int>(lut.size()) - 1;
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
-    std::vector<float> ds, ws;
+    std::vector<Weighted> samples((radius + 1) * (radius + 1));  // radius / 2 + 1 per axis
     for (int x = 0; x < v.width; ++x) {
       if (!bad(y, x)) continue;
-      ds.clear();
-      ws.clear();
       const cv::Vec3f& c = v.color(y, x);
       float total = 0.f;
+      int n = 0;
       // Every second row and column of the window: the median barely changes, the cost quarters.
       for (int yy = std::max(0, y - radius); yy <= std::min(v.height - 1, y + radius); yy += 2) {
         const float* frow = filled.ptr<float>(yy);
@@ -151,15 +154,12 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
           const cv::Vec3f& q = crow[xx];
           const int l1 = static_cast<int>(std::abs(q[0] - c[0]) + std::abs(q[1] - c[1]) +
                                           std::abs(q[2] - c[2]));
-          const float w = lut[std::min<int>(l1, static_cast<int>(lut.size()) - 1)];
-          ds.push_back(d);
-          ws.push_back(w);
+          const float w = lut[std::min(l1, lut_last)];
+          samples[n++] = Weighted{d, w};
           total += w;
         }
       }
-      if (ds.empty()) continue;
-      disparity(y, x) =
-          weightedMedian(ds.data(), ws.data(), static_cast<int>(ds.size()), 0.5f * total);
+      if (n > 0) disparity(y, x) = weightedMedian(samples.data(), n, 0.5f * total);
     }
   }
 }

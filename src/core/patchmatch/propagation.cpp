@@ -79,6 +79,20 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
     if (self_.match_sign < 0) polishSettled(x, y, idx, iteration, cache);
     return;
   }
+  // Spatial propagation: forward sweeps look left/up, backward sweeps right/down.
+  const int step = forward ? -1 : 1;
+  const int nx = x + step, ny = y + step;
+  const bool has_x = nx >= 0 && nx < self_.width, has_y = ny >= 0 && ny < self_.height;
+  if (options_.tolerance > 0.f && !options_.refine && !options_.subpixel) {
+    // Propagation alone with a tolerance: no window unless some candidate is worth a cost.
+    const Plane& own = self_.planes[idx];
+    if (!(self_.offered[idx] && worthTrying(x, y, self_.offer[idx], own)) &&
+        !(has_x && worthTrying(x, y, self_.planes[idx + step], own)) &&
+        !(has_y && worthTrying(x, y, self_.planes[idx + step * self_.width], own))) {
+      self_.offered[idx] = 0;
+      return;
+    }
+  }
   cost_.buildWindow(x, y, cache);
   Plane best = self_.planes[idx];
   float best_cost = currentCost(idx, cache);
@@ -86,13 +100,8 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
     tryPlane(x, y, self_.offer[idx], cache, best, best_cost);
     self_.offered[idx] = 0;
   }
-  // Spatial propagation: forward sweeps look left/up, backward sweeps right/down.
-  const int step = forward ? -1 : 1;
-  const int nx = x + step, ny = y + step;
-  if (nx >= 0 && nx < self_.width) tryPlane(x, y, self_.planes[idx + step], cache, best, best_cost);
-  if (ny >= 0 && ny < self_.height) {
-    tryPlane(x, y, self_.planes[idx + step * self_.width], cache, best, best_cost);
-  }
+  if (has_x) tryPlane(x, y, self_.planes[idx + step], cache, best, best_cost);
+  if (has_y) tryPlane(x, y, self_.planes[idx + step * self_.width], cache, best, best_cost);
   if (options_.refine) {
     Rng rng(streamKey(p_.seed, self_.match_sign < 0 ? 0 : 1, iteration, idx));
     refine(x, y, cache, rng, best, best_cost);
@@ -124,13 +133,21 @@ float PlaneSearch::currentCost(int idx, const WindowCache& cache) const {
   return self_.cost[idx];
 }
 
+bool PlaneSearch::worthTrying(int x, int y, const Plane& candidate, const Plane& current) const {
+  const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+  const float d = candidate.at(fx, fy);
+  if (options_.tolerance > 0.f && std::abs(d - current.at(fx, fy)) <= options_.tolerance) {
+    return false;
+  }
+  return !nearlySame(candidate, current, fx, fy) && admissible(x, y, d);
+}
+
 void PlaneSearch::tryPlane(int x, int y, const Plane& candidate, const WindowCache& cache,
                            Plane& best, float& best_cost) const {
   // Propagation often offers (nearly) the plane the pixel already has: evaluating it cannot
-  // change the result by more than the tolerance, so skip it.
-  const float fx = static_cast<float>(x), fy = static_cast<float>(y);
-  if (nearlySame(candidate, best, fx, fy)) return;
-  if (!admissible(x, y, candidate.at(fx, fy))) return;
+  // change the result by more than the tolerance (kSamePlaneTolerance or the options'), so skip
+  // it.
+  if (!worthTrying(x, y, candidate, best)) return;
   const float c = cost_.aggregate(cache, candidate, best_cost);
   if (c < best_cost) {
     best = candidate;

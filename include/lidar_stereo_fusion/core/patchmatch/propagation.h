@@ -35,6 +35,11 @@ namespace patchmatch {
 struct SearchOptions {
   bool refine = true;     ///< random plane refinement after spatial propagation
   bool subpixel = false;  ///< subpixelStep() ends the pixel's search (after refinement if refine)
+  /// [px] candidates whose disparity at the pixel is within this of the current plane's are not
+  /// evaluated, and a pixel with no other candidate builds no window (0: only nearlySame ones).
+  /// For a view that only serves the left-right check (tolerance lr_max_diff), such a candidate
+  /// could move its verdict by no more than this.
+  float tolerance = 0.f;
 };
 
 class PlaneSearch {
@@ -62,6 +67,10 @@ class PlaneSearch {
   /// by the coarse level, in the left view only: its plane comes from a level of half the size,
   /// whose refinement stops at 0.1 px there (0.2 px here).
   void polishSettled(int x, int y, int idx, int iteration, WindowCache& cache) const;
+
+  /// Whether tryPlane would evaluate `candidate` against `current`: admissible at (x, y), not
+  /// nearlySame and not within SearchOptions::tolerance.
+  bool worthTrying(int x, int y, const Plane& candidate, const Plane& current) const;
 
   /// Replaces (best, best_cost) by `candidate` when it is admissible and cheaper.
   void tryPlane(int x, int y, const Plane& candidate, const WindowCache& cache, Plane& best,
