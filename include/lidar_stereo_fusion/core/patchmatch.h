@@ -65,8 +65,9 @@ struct PatchMatchParams {
   double fill_confidence = 0.5;
   /// Coarse start (patchmatch/coarse_to_fine.h): the search first runs on images reduced by
   /// coarse_scale^coarse_levels (1 = off), then at each larger level `fine_iterations` sweeps start
-  /// from the planes of the level below, refining every searched pixel from +-fine_refine_range
-  /// (instead of half the image's disparity range, or the scan lines' range).
+  /// from the planes of the level below; a view that refines there refines every searched pixel
+  /// from +-fine_refine_range (instead of half the image's disparity range, or the scan lines'
+  /// range; 0.5 or 0.25 px: synthetic slanted planes 0.055 px off instead of 0.045).
   int coarse_scale = 2;
   int coarse_levels = 2;
   /// Whether the pixels without scan-line bounds (no LiDAR above and below) are searched at full
@@ -86,10 +87,11 @@ struct PatchMatchParams {
   /// alone would need more candidates for the same precision (synthetic planes: 0.045 px mean
   /// error with the step, 0.055 px without).
   bool fine_subpixel = true;
-  /// Full-size level of a coarse start only: random refinement of the left view from
-  /// +-fine_refine_range before the sub-pixel step. false: the step alone polishes the level
-  /// below's planes (half the cost evaluations of the level; KITTI and Middlebury within a few
-  /// per cent either way).
+  /// Every level after the coarse start (1/2 and full size): random refinement of the left view
+  /// from +-fine_refine_range (then, at full size, the sub-pixel step). false: the left view takes
+  /// planes by propagation and from the right view (which refines at 1/2 size), and at full size
+  /// the sub-pixel step alone polishes them (half the cost evaluations of the levels; KITTI and
+  /// Middlebury within a few per cent either way).
   bool fine_refine = false;
   int num_threads = 0;           ///< 0 = all cores (at most 256)
   uint64_t seed = 42;
