@@ -1,61 +1,26 @@
 // PatchMatch, step by step, with exact answers: the plane xi (patchmatch/plane.h), the cost C with
-// w and phi (cost.h), the search steps (propagation.h), view propagation, the left-right check and
-// filling (post_processing.h) and the coarse start (coarse_to_fine.h).
+// w and phi (cost.h), the search steps (propagation.h) and view propagation. The left-right check,
+// filling and the coarse start: test_patchmatch_levels.cpp.
 #include <cmath>
 #include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
 #include "lidar_stereo_fusion/core/patchmatch/cost.h"
-#include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
 #include "lidar_stereo_fusion/core/patchmatch/propagation.h"
+#include "patchmatch_steps_util.h"
 #include "test_scenes.h"
 
 namespace lsf = lidar_stereo_fusion;
 namespace pm = lidar_stereo_fusion::patchmatch;
 
-namespace {
-
-/// Uniform images: every support weight is 1 and every gradient 0.
-cv::Mat uniform(int w, int h, uchar value) {
-  return cv::Mat(h, w, CV_8UC3, cv::Scalar::all(value));
-}
-
-lsf::PatchMatchParams params3x3() {
-  lsf::PatchMatchParams p;  // defaults: alpha 0.01, beta 0.09, gamma 0.9, weighted
-  p.window_radius = 1;
-  p.window_stride = 1;
-  p.coarse_scale = 1;
-  return p;
-}
-
-struct Views {
-  pm::ViewState left, right;
-};
-
-/// A view searched by propagation alone (no plane refinement).
-pm::SearchOptions propagationOnly() {
-  pm::SearchOptions o;
-  o.refine = false;
-  return o;
-}
-
-Views prepare(const lsf::ViewInput& l, const lsf::ViewInput& r, const lsf::PatchMatchParams& p) {
-  Views v;
-  pm::prepareView(l, p, -1.f, v.left);
-  pm::prepareView(r, p, +1.f, v.right);
-  return v;
-}
-
-float costOf(const pm::MatchingCost& cost, int x, int y, const pm::Plane& plane) {
-  pm::WindowCache cache;
-  cost.buildWindow(x, y, cache);
-  return cost.aggregate(cache, plane, std::numeric_limits<float>::max());
-}
-
-}  // namespace
+using lidar_stereo_fusion::test::costOf;
+using lidar_stereo_fusion::test::params3x3;
+using lidar_stereo_fusion::test::prepare;
+using lidar_stereo_fusion::test::propagationOnly;
+using lidar_stereo_fusion::test::uniform;
+using lidar_stereo_fusion::test::Views;
 
 TEST(PatchMatchPlane, NormalFormAndTransferBetweenViewsAreExact) {
   const pm::Plane p = pm::planeFromNormal(10.f, 20.f, 8.f, 0.f, 0.f, 1.f);
@@ -280,6 +245,34 @@ TEST(PatchMatchSearch, PolishWithoutRefinementStepsDOnlyAndKeepsTheNormal) {
   EXPECT_EQ(got.b, 0.f);
 }
 
+TEST(PatchMatchSearch, ATolerantPropagationSkipsNearCandidatesAndBuildsNoWindowForThem) {
+  // The full-size right view (it serves the left-right check only): candidates within the
+  // tolerance of the current plane are not evaluated.
+  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(80, 30, 0.0, 0.0, 9.2, 5);
+  lsf::PatchMatchParams p = params3x3();
+  p.window_radius = 3;
+  Views v = prepare({s.left}, {s.right}, p);
+  const int idx = 15 * 80 + 40;
+  for (const float tolerance : {0.f, 0.25f, 0.1f}) {
+    pm::SearchOptions o = propagationOnly();
+    o.tolerance = tolerance;
+    const pm::PlaneSearch search(p, v.left, v.right, o);
+    v.left.planes[idx] = pm::Plane{0.f, 0.f, 9.f};
+    v.left.cost[idx] = pm::kUnknownCost;
+    v.left.planes[idx - 1] = pm::Plane{0.f, 0.f, 9.2f};  // the true plane, 0.2 px away
+    v.left.planes[idx - 80] = pm::Plane{0.f, 0.f, 9.f};
+    pm::WindowCache cache;
+    search.processPixel(40, 15, true, 0, cache);
+    if (tolerance == 0.25f) {
+      EXPECT_EQ(v.left.planes[idx].c, 9.f);           // kept: 0.2 px is within the tolerance
+      EXPECT_EQ(v.left.cost[idx], pm::kUnknownCost);  // no window was built, no cost computed
+    } else {
+      EXPECT_EQ(v.left.planes[idx].c, 9.2f) << tolerance;  // evaluated and taken
+      EXPECT_NE(v.left.cost[idx], pm::kUnknownCost) << tolerance;
+    }
+  }
+}
+
 TEST(PatchMatchViewPropagation, AGoodLeftPlaneReachesItsMatchInTheRightView) {
   const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(80, 20, 0.0, 0.0, 6.0, 9);
   lsf::PatchMatchParams p = params3x3();
@@ -323,123 +316,4 @@ TEST(PatchMatchViewPropagation, OfferedPlanesAreTriedWhenTheSweepVisitsAndTheNea
   EXPECT_EQ(v.right.planes[idx].c, 6.f);
   EXPECT_LT(v.right.cost[idx], 1e-2f);
   EXPECT_FALSE(v.right.offered[idx]);  // withdrawn once tried
-}
-
-TEST(PatchMatchPostProcessing, LeftRightCheckMarksDisagreementsAndKeepsWhatItCannotCheck) {
-  cv::Mat1f left(1, 8, 2.f), right(1, 8, 2.f);
-  right(0, 3) = 5.f;  // left pixel 5 (d = 2) matches right pixel 3: disagrees by 3
-  const cv::Mat1b bad = pm::leftRightCheck(left, right, 1.f, {});
-  EXPECT_EQ(bad(0, 5), 255);
-  EXPECT_EQ(bad(0, 4), 0);
-  EXPECT_EQ(bad(0, 0), 0);  // match at -2: outside, kept
-  EXPECT_EQ(pm::leftRightCheck(left, right, 1.f, {}, true)(0, 0), 255);  // ... unless asked
-  std::vector<uint8_t> keep(8, 0);
-  keep[5] = 1;
-  EXPECT_EQ(pm::leftRightCheck(left, right, 1.f, keep)(0, 5), 0);  // locked: kept
-}
-
-TEST(PatchMatchPostProcessing, ConfidentPriorFillsElseTheBackgroundNeighbour) {
-  lsf::PatchMatchParams p = params3x3();
-  cv::Mat1f prior = cv::Mat1f::zeros(1, 7), conf = cv::Mat1f::zeros(1, 7);
-  prior(0, 2) = 9.f;
-  conf(0, 2) = 0.8f;
-  prior(0, 4) = 7.f;
-  conf(0, 4) = 0.2f;  // too weak to fill
-  Views v = prepare({uniform(7, 1, 60), prior, {}, conf}, {uniform(7, 1, 60)}, p);
-  for (int x = 0; x < 7; ++x) v.left.planes[x] = pm::Plane{0.f, 0.f, x < 4 ? 12.f : 3.f};
-  cv::Mat1f disparity = pm::disparityOf(v.left);
-  cv::Mat1b bad = cv::Mat1b::zeros(1, 7);
-  bad(0, 2) = bad(0, 4) = 255;
-  pm::fillHoles(v.left, bad, 1, 10.f, 0.5f, 192.f, disparity, 1);
-  EXPECT_EQ(disparity(0, 2), 9.f);  // the prior
-  EXPECT_EQ(disparity(0, 4), 3.f);  // min(12 from the left, 3 from the right): the background
-  EXPECT_EQ(disparity(0, 0), 12.f);
-}
-
-TEST(PatchMatchPostProcessing, AFillNeverPassesTheSearchRange) {
-  lsf::PatchMatchParams p = params3x3();
-  Views v = prepare({uniform(9, 1, 60)}, {uniform(9, 1, 60)}, p);
-  // d = 20 x + 80 on pixels 0..4 (160 px at x = 4); pixels 5..8 failed the check and have no
-  // right neighbour: pixel 4's plane reaches 180, 200, 220, 240 px there, beyond 192 from x = 6.
-  for (int x = 0; x < 9; ++x) v.left.planes[x] = pm::Plane{20.f, 0.f, 80.f};
-  cv::Mat1f disparity = pm::disparityOf(v.left);
-  cv::Mat1b bad = cv::Mat1b::zeros(1, 9);
-  for (int x = 5; x < 9; ++x) bad(0, x) = 255;
-  pm::fillHoles(v.left, bad, 2, 10.f, 0.5f, 192.f, disparity, 1);
-  for (int x = 5; x < 9; ++x) EXPECT_LE(disparity(0, x), 192.f) << x;
-  EXPECT_EQ(disparity(0, 8), 0.f);    // its window (pixels 6, 8) holds no fill: left empty
-  EXPECT_EQ(disparity(0, 5), 140.f);  // the median of its window: pixels 3 (140) and 5 (180)
-}
-
-TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {
-  lsf::PatchMatchParams p = params3x3();
-  p.full_size_unbounded = false;
-  lsf::ScanLineBounds b;
-  b.lo = cv::Mat1f::zeros(4, 6);
-  b.hi = cv::Mat1f::zeros(4, 6);
-  b.range = cv::Mat1f::zeros(4, 6);
-  for (int x = 0; x < 6; ++x) b.hi(2, x) = b.lo(2, x) = 5.f;  // row 2 lies between scan lines
-  cv::Mat1f prior = cv::Mat1f::zeros(4, 6), conf = cv::Mat1f::zeros(4, 6);
-  prior(3, 0) = 5.f;
-  conf(3, 0) = 1.f;  // one pixel locked to the prior
-  Views v = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
-  pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, v.left);
-  EXPECT_EQ(v.left.locked[0 * 6 + 1], pm::kSettledByGuide);
-  EXPECT_EQ(v.left.locked[2 * 6 + 1], 0);  // bounded: searched
-  EXPECT_EQ(v.left.locked[3 * 6 + 0], pm::kLockedToPrior);
-  const pm::PlaneSearch search(p, v.left, v.right);
-  pm::Rng rng(3);
-  EXPECT_EQ(search.initialPlane(1, 0, rng).c, 7.f);
-  p.full_size_unbounded = true;
-  Views w = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
-  pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, w.left);
-  EXPECT_EQ(w.left.locked[0 * 6 + 1], 0);
-}
-
-TEST(PatchMatchCoarseStart, PlanesScaleToFullSizeAndViewsReduceExactly) {
-  cv::Mat3f coarse(2, 3, cv::Vec3f(0.f, 0.f, 0.f));
-  coarse(1, 2) = cv::Vec3f(0.5f, 0.25f, 3.f);
-  const std::vector<pm::Plane> full = pm::upsamplePlanes(coarse, 4, cv::Size(12, 8));
-  // Full pixel (9, 5) lies in coarse pixel (2, 1), whose centre is at full (9.5, 5.5) = coarse
-  // (2, 1): d_full(9.5, 5.5) = 4 d_coarse(2, 1) = 4 (1 + 0.25 + 3) = 17.
-  const pm::Plane& p = full[5 * 12 + 9];
-  EXPECT_FLOAT_EQ(p.at(9.5f, 5.5f), 17.f);
-  EXPECT_FLOAT_EQ(p.a, 0.5f);
-  lsf::ViewInput in{uniform(12, 8, 7), cv::Mat1f(8, 12, 8.f), {}, cv::Mat1f(8, 12, 0.75f)};
-  const lsf::ViewInput small = pm::downsampleView(in, 4);
-  EXPECT_EQ(small.image.size(), cv::Size(3, 2));
-  EXPECT_EQ(small.prior(1, 1), 2.f);
-  EXPECT_EQ(small.confidence(1, 1), 0.75f);
-  lsf::PatchMatchParams params;
-  params.coarse_scale = 4;
-  params.coarse_levels = 1;
-  const lsf::PatchMatchParams c = pm::coarseParams(params);
-  EXPECT_EQ(c.window_radius, 2);
-  EXPECT_EQ(c.window_stride, 1);
-  EXPECT_EQ(c.max_disparity, params.max_disparity / 4);
-  EXPECT_EQ(c.coarse_scale, 1);
-  EXPECT_FALSE(c.lr_check);
-  // Two levels of 2: the level below is itself a coarse start of one level.
-  params.coarse_scale = 2;
-  params.coarse_levels = 2;
-  const lsf::PatchMatchParams half = pm::coarseParams(params);
-  EXPECT_EQ(half.window_radius, 4);
-  EXPECT_EQ(half.coarse_scale, 2);
-  EXPECT_EQ(half.coarse_levels, 1);
-  EXPECT_TRUE(half.full_size_unbounded);
-  EXPECT_EQ(pm::coarseParams(half).window_radius, 2);
-}
-
-TEST(PatchMatchCoarseStart, LeftRightCheckWithoutViewPropagationRuns) {
-  // The coarse levels have no left-right check: without view propagation they have no right
-  // view, and the full-size right view starts without a guide.
-  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(96, 48, 0.0, 0.0, 5.0, 4);
-  lsf::PatchMatchParams p;
-  p.view_propagation = false;
-  p.lr_check = true;
-  p.max_disparity = 16;
-  lsf::PatchMatchStereo pm(p);
-  const lsf::PatchMatchResult r = pm.compute({s.left}, {s.right});
-  EXPECT_EQ(r.disparity.size(), s.left.size());
-  EXPECT_NEAR(r.disparity(24, 48), 5.f, 0.5f);
 }

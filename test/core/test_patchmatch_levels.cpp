@@ -1,0 +1,139 @@
+// PatchMatch after the search, with exact answers: the left-right check and filling
+// (post_processing.h), and the coarse start (coarse_to_fine.h).
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
+#include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
+#include "patchmatch_steps_util.h"
+#include "test_scenes.h"
+
+namespace lsf = lidar_stereo_fusion;
+namespace pm = lidar_stereo_fusion::patchmatch;
+
+using lidar_stereo_fusion::test::params3x3;
+using lidar_stereo_fusion::test::prepare;
+using lidar_stereo_fusion::test::uniform;
+using lidar_stereo_fusion::test::Views;
+
+TEST(PatchMatchPostProcessing, LeftRightCheckMarksDisagreementsAndKeepsWhatItCannotCheck) {
+  cv::Mat1f left(1, 8, 2.f), right(1, 8, 2.f);
+  right(0, 3) = 5.f;  // left pixel 5 (d = 2) matches right pixel 3: disagrees by 3
+  const cv::Mat1b bad = pm::leftRightCheck(left, right, 1.f, {});
+  EXPECT_EQ(bad(0, 5), 255);
+  EXPECT_EQ(bad(0, 4), 0);
+  EXPECT_EQ(bad(0, 0), 0);  // match at -2: outside, kept
+  EXPECT_EQ(pm::leftRightCheck(left, right, 1.f, {}, true)(0, 0), 255);  // ... unless asked
+  std::vector<uint8_t> keep(8, 0);
+  keep[5] = 1;
+  EXPECT_EQ(pm::leftRightCheck(left, right, 1.f, keep)(0, 5), 0);  // locked: kept
+}
+
+TEST(PatchMatchPostProcessing, ConfidentPriorFillsElseTheBackgroundNeighbour) {
+  lsf::PatchMatchParams p = params3x3();
+  cv::Mat1f prior = cv::Mat1f::zeros(1, 7), conf = cv::Mat1f::zeros(1, 7);
+  prior(0, 2) = 9.f;
+  conf(0, 2) = 0.8f;
+  prior(0, 4) = 7.f;
+  conf(0, 4) = 0.2f;  // too weak to fill
+  Views v = prepare({uniform(7, 1, 60), prior, {}, conf}, {uniform(7, 1, 60)}, p);
+  for (int x = 0; x < 7; ++x) v.left.planes[x] = pm::Plane{0.f, 0.f, x < 4 ? 12.f : 3.f};
+  cv::Mat1f disparity = pm::disparityOf(v.left);
+  cv::Mat1b bad = cv::Mat1b::zeros(1, 7);
+  bad(0, 2) = bad(0, 4) = 255;
+  pm::fillHoles(v.left, bad, 1, 10.f, 0.5f, 192.f, disparity, 1);
+  EXPECT_EQ(disparity(0, 2), 9.f);  // the prior
+  EXPECT_EQ(disparity(0, 4), 3.f);  // min(12 from the left, 3 from the right): the background
+  EXPECT_EQ(disparity(0, 0), 12.f);
+}
+
+TEST(PatchMatchPostProcessing, AFillNeverPassesTheSearchRange) {
+  lsf::PatchMatchParams p = params3x3();
+  Views v = prepare({uniform(9, 1, 60)}, {uniform(9, 1, 60)}, p);
+  // d = 20 x + 80 on pixels 0..4 (160 px at x = 4); pixels 5..8 failed the check and have no
+  // right neighbour: pixel 4's plane reaches 180, 200, 220, 240 px there, beyond 192 from x = 6.
+  for (int x = 0; x < 9; ++x) v.left.planes[x] = pm::Plane{20.f, 0.f, 80.f};
+  cv::Mat1f disparity = pm::disparityOf(v.left);
+  cv::Mat1b bad = cv::Mat1b::zeros(1, 9);
+  for (int x = 5; x < 9; ++x) bad(0, x) = 255;
+  pm::fillHoles(v.left, bad, 2, 10.f, 0.5f, 192.f, disparity, 1);
+  for (int x = 5; x < 9; ++x) EXPECT_LE(disparity(0, x), 192.f) << x;
+  EXPECT_EQ(disparity(0, 8), 0.f);    // its window (pixels 6, 8) holds no fill: left empty
+  EXPECT_EQ(disparity(0, 5), 140.f);  // the median of its window: pixels 3 (140) and 5 (180)
+}
+
+TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {
+  lsf::PatchMatchParams p = params3x3();
+  p.full_size_unbounded = false;
+  lsf::ScanLineBounds b;
+  b.lo = cv::Mat1f::zeros(4, 6);
+  b.hi = cv::Mat1f::zeros(4, 6);
+  b.range = cv::Mat1f::zeros(4, 6);
+  for (int x = 0; x < 6; ++x) b.hi(2, x) = b.lo(2, x) = 5.f;  // row 2 lies between scan lines
+  cv::Mat1f prior = cv::Mat1f::zeros(4, 6), conf = cv::Mat1f::zeros(4, 6);
+  prior(3, 0) = 5.f;
+  conf(3, 0) = 1.f;  // one pixel locked to the prior
+  Views v = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
+  pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, v.left);
+  EXPECT_EQ(v.left.locked[0 * 6 + 1], pm::kSettledByGuide);
+  EXPECT_EQ(v.left.locked[2 * 6 + 1], 0);  // bounded: searched
+  EXPECT_EQ(v.left.locked[3 * 6 + 0], pm::kLockedToPrior);
+  const pm::PlaneSearch search(p, v.left, v.right);
+  pm::Rng rng(3);
+  EXPECT_EQ(search.initialPlane(1, 0, rng).c, 7.f);
+  p.full_size_unbounded = true;
+  Views w = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
+  pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, w.left);
+  EXPECT_EQ(w.left.locked[0 * 6 + 1], 0);
+}
+
+TEST(PatchMatchCoarseStart, PlanesScaleToFullSizeAndViewsReduceExactly) {
+  cv::Mat3f coarse(2, 3, cv::Vec3f(0.f, 0.f, 0.f));
+  coarse(1, 2) = cv::Vec3f(0.5f, 0.25f, 3.f);
+  const std::vector<pm::Plane> full = pm::upsamplePlanes(coarse, 4, cv::Size(12, 8));
+  // Full pixel (9, 5) lies in coarse pixel (2, 1), whose centre is at full (9.5, 5.5) = coarse
+  // (2, 1): d_full(9.5, 5.5) = 4 d_coarse(2, 1) = 4 (1 + 0.25 + 3) = 17.
+  const pm::Plane& p = full[5 * 12 + 9];
+  EXPECT_FLOAT_EQ(p.at(9.5f, 5.5f), 17.f);
+  EXPECT_FLOAT_EQ(p.a, 0.5f);
+  lsf::ViewInput in{uniform(12, 8, 7), cv::Mat1f(8, 12, 8.f), {}, cv::Mat1f(8, 12, 0.75f)};
+  const lsf::ViewInput small = pm::downsampleView(in, 4);
+  EXPECT_EQ(small.image.size(), cv::Size(3, 2));
+  EXPECT_EQ(small.prior(1, 1), 2.f);
+  EXPECT_EQ(small.confidence(1, 1), 0.75f);
+  lsf::PatchMatchParams params;
+  params.coarse_scale = 4;
+  params.coarse_levels = 1;
+  const lsf::PatchMatchParams c = pm::coarseParams(params);
+  EXPECT_EQ(c.window_radius, 2);
+  EXPECT_EQ(c.window_stride, 1);
+  EXPECT_EQ(c.max_disparity, params.max_disparity / 4);
+  EXPECT_EQ(c.coarse_scale, 1);
+  EXPECT_FALSE(c.lr_check);
+  // Two levels of 2: the level below is itself a coarse start of one level.
+  params.coarse_scale = 2;
+  params.coarse_levels = 2;
+  const lsf::PatchMatchParams half = pm::coarseParams(params);
+  EXPECT_EQ(half.window_radius, 4);
+  EXPECT_EQ(half.coarse_scale, 2);
+  EXPECT_EQ(half.coarse_levels, 1);
+  EXPECT_TRUE(half.full_size_unbounded);
+  EXPECT_EQ(pm::coarseParams(half).window_radius, 2);
+}
+
+TEST(PatchMatchCoarseStart, LeftRightCheckWithoutViewPropagationRuns) {
+  // The coarse levels have no left-right check: without view propagation they have no right
+  // view, and the full-size right view starts without a guide.
+  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(96, 48, 0.0, 0.0, 5.0, 4);
+  lsf::PatchMatchParams p;
+  p.view_propagation = false;
+  p.lr_check = true;
+  p.max_disparity = 16;
+  lsf::PatchMatchStereo pm(p);
+  const lsf::PatchMatchResult r = pm.compute({s.left}, {s.right});
+  EXPECT_EQ(r.disparity.size(), s.left.size());
+  EXPECT_NEAR(r.disparity(24, 48), 5.f, 0.5f);
+}
