@@ -5,10 +5,10 @@
 //
 // Per iteration: left view sweep. In the last `right_iterations` iterations also: view
 // propagation of the left planes into the right view, right view sweep, view propagation back
-// into the left (unless the right view was swept by propagation alone). Then the left-right check and filling. At the full-size level after a coarse
-// start, the right view sweeps by propagation alone (fine_right_view) and the left view polishes
-// each pixel's plane with a sub-pixel step (fine_subpixel), after a random refinement only if
-// fine_refine.
+// into the left (unless the right view was swept by propagation alone). Then the left-right check
+// and filling. At the full-size level after a coarse start, the right view sweeps by propagation
+// alone (fine_right_view) and the left view polishes each pixel's plane with a sub-pixel step
+// (fine_subpixel), after a random refinement only if fine_refine.
 #include <algorithm>
 #include <cmath>
 #include <future>
@@ -134,8 +134,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   }
 
   // The full-size level after a coarse start polishes the planes it was given: the left view
-  // with a sub-pixel step (after random refinement if fine_refine); the right view, which serves view propagation and
-  // the left-right check, by propagation alone unless fine_right_view.
+  // with a sub-pixel step (after random refinement if fine_refine); the right view, which then
+  // serves the left-right check only, by propagation alone unless fine_right_view.
   SearchOptions left_options, right_options;
   left_options.subpixel = guided && p.fine_subpixel;
   left_options.refine = !guided || p.fine_refine;
