@@ -48,6 +48,15 @@ inline Views prepare(const lidar_stereo_fusion::ViewInput& l,
   return v;
 }
 
+/// Front-parallel planes d = own at pixel idx (cost unknown), d = left at its left neighbour and
+/// d = up at its upper neighbour (the candidates of a forward sweep's propagation).
+inline void frontoParallelAround(pm::ViewState& v, int idx, float own, float left, float up) {
+  v.planes[idx] = pm::Plane{0.f, 0.f, own};
+  v.cost[idx] = pm::kUnknownCost;
+  v.planes[idx - 1] = pm::Plane{0.f, 0.f, left};
+  v.planes[idx - v.width] = pm::Plane{0.f, 0.f, up};
+}
+
 inline float costOf(const pm::MatchingCost& cost, int x, int y, const pm::Plane& plane) {
   pm::WindowCache cache;
   cost.buildWindow(x, y, cache);

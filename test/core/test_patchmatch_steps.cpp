@@ -16,6 +16,7 @@ namespace lsf = lidar_stereo_fusion;
 namespace pm = lidar_stereo_fusion::patchmatch;
 
 using lidar_stereo_fusion::test::costOf;
+using lidar_stereo_fusion::test::frontoParallelAround;
 using lidar_stereo_fusion::test::params3x3;
 using lidar_stereo_fusion::test::prepare;
 using lidar_stereo_fusion::test::propagationOnly;
@@ -207,10 +208,7 @@ TEST(PatchMatchSearch, WithoutRefinementAPixelOnlyTakesItsNeighboursPlane) {
     const pm::PlaneSearch search(p, v.left, v.right,
                                  refine ? pm::SearchOptions() : propagationOnly());
     const int idx = 15 * 80 + 40;
-    v.left.planes[idx] = pm::Plane{0.f, 0.f, 7.f};
-    v.left.cost[idx] = pm::kUnknownCost;
-    v.left.planes[idx - 1] = pm::Plane{0.f, 0.f, 9.f};  // the left neighbour has the true plane
-    v.left.planes[idx - 80] = pm::Plane{0.f, 0.f, 7.f};
+    frontoParallelAround(v.left, idx, 7.f, 9.f, 7.f);  // the left neighbour has the true plane
     pm::WindowCache cache;
     search.processPixel(40, 15, true, 0, cache);
     if (refine) {
@@ -232,10 +230,7 @@ TEST(PatchMatchSearch, PolishWithoutRefinementStepsDOnlyAndKeepsTheNormal) {
   polish.subpixel = true;
   const pm::PlaneSearch search(p, v.left, v.right, polish);
   const int idx = 15 * 80 + 40;
-  v.left.planes[idx] = pm::Plane{0.f, 0.f, 7.f};
-  v.left.cost[idx] = pm::kUnknownCost;
-  v.left.planes[idx - 1] = pm::Plane{0.f, 0.f, 9.06f};  // the neighbour is 0.06 px off
-  v.left.planes[idx - 80] = pm::Plane{0.f, 0.f, 7.f};
+  frontoParallelAround(v.left, idx, 7.f, 9.06f, 7.f);  // the left neighbour is 0.06 px off
   pm::WindowCache cache;
   search.processPixel(40, 15, true, 0, cache);
   const pm::Plane& got = v.left.planes[idx];
@@ -257,10 +252,7 @@ TEST(PatchMatchSearch, ATolerantPropagationSkipsNearCandidatesAndBuildsNoWindowF
     pm::SearchOptions o = propagationOnly();
     o.tolerance = tolerance;
     const pm::PlaneSearch search(p, v.left, v.right, o);
-    v.left.planes[idx] = pm::Plane{0.f, 0.f, 9.f};
-    v.left.cost[idx] = pm::kUnknownCost;
-    v.left.planes[idx - 1] = pm::Plane{0.f, 0.f, 9.2f};  // the true plane, 0.2 px away
-    v.left.planes[idx - 80] = pm::Plane{0.f, 0.f, 9.f};
+    frontoParallelAround(v.left, idx, 9.f, 9.2f, 9.f);  // the left one true, 0.2 px away
     pm::WindowCache cache;
     search.processPixel(40, 15, true, 0, cache);
     if (tolerance == 0.25f) {
