@@ -137,3 +137,77 @@ TEST(PatchMatchCoarseStart, LeftRightCheckWithoutViewPropagationRuns) {
   EXPECT_EQ(r.disparity.size(), s.left.size());
   EXPECT_NEAR(r.disparity(24, 48), 5.f, 0.5f);
 }
+
+TEST(PatchMatchCoarseStart, MaskScalesToFullSizeLikeThePlanes) {
+  // Full pixel (x, y) takes coarse pixel (x / 2, y / 2); an odd size repeats the last coarse one.
+  cv::Mat1b coarse(2, 3, uchar(0));
+  coarse(0, 1) = 255;
+  coarse(1, 2) = 255;
+  const cv::Mat1b full = pm::upsampleMask(coarse, 2, cv::Size(5, 3));
+  const uchar expected[3][5] = {{0, 0, 255, 255, 0}, {0, 0, 255, 255, 0}, {0, 0, 0, 0, 255}};
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 5; ++x) EXPECT_EQ(full(y, x), expected[y][x]) << x << ", " << y;
+  }
+}
+
+namespace {
+
+/// A textured box at disparity 12 (columns [40, 70) of the left view) before a textured
+/// background at 4: the background columns [32, 40) of the left view are hidden in the right.
+struct BoxScene {
+  cv::Mat left, right;
+  static constexpr int kBox0 = 40, kBox1 = 70;
+  static constexpr double kBox = 12, kBack = 4;
+  static BoxScene make(int width, int height) {
+    const lsf::test::Texture back(5), box(6);
+    BoxScene s{cv::Mat(height, width, CV_8UC3), cv::Mat(height, width, CV_8UC3)};
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const bool in_box = x >= kBox0 && x < kBox1;
+        s.left.at<cv::Vec3b>(y, x) = in_box ? box.at(x, y) : back.at(x, y);
+        const double xl = x + kBox;  // right pixel x sees the box if the box is at x + 12
+        s.right.at<cv::Vec3b>(y, x) =
+            xl >= kBox0 && xl < kBox1 ? box.at(xl, y) : back.at(x + kBack, y);
+      }
+    }
+    return s;
+  }
+};
+
+}  // namespace
+
+TEST(PatchMatchCoarseStart, TheLeftRightCheckRunsAtHalfSizeUnlessAsked) {
+  const BoxScene s = BoxScene::make(128, 64);
+  lsf::PatchMatchParams p;
+  p.alpha = 0.5;
+  p.beta = 0.5;
+  p.gamma = 0.0;
+  p.max_disparity = 24;
+  for (const bool fine_lr_check : {false, true}) {
+    p.fine_lr_check = fine_lr_check;
+    lsf::PatchMatchStereo matcher(p);
+    const lsf::PatchMatchResult r = matcher.compute({s.left}, {s.right});
+    // The full-size right view is searched only for a full-size check.
+    EXPECT_EQ(r.right_disparity.empty(), !fine_lr_check);
+    // Either check finds the hidden strip (inner columns; half-size pixels straddle its ends) and
+    // little else inside the image; most of the strip is filled with the background (86 % and
+    // 81 %: the median over the window reaches the box at the strip's right end).
+    int hidden = 0, flagged_hidden = 0, seen = 0, flagged_seen = 0, filled_back = 0;
+    for (int y = 8; y < 56; ++y) {
+      for (int x = 24; x < 104; ++x) {
+        const bool bad = r.inconsistent(y, x) != 0;
+        if (x >= 34 && x < 38) {
+          ++hidden;
+          flagged_hidden += bad;
+          filled_back += std::abs(r.disparity(y, x) - BoxScene::kBack) < 1.0;
+        } else if (x < 30 || (x >= 42 && x < 68) || x >= 72) {
+          ++seen;
+          flagged_seen += bad;
+        }
+      }
+    }
+    EXPECT_GT(flagged_hidden, 0.9 * hidden) << "fine_lr_check " << fine_lr_check;
+    EXPECT_LT(flagged_seen, 0.02 * seen) << "fine_lr_check " << fine_lr_check;
+    EXPECT_GT(filled_back, 0.75 * hidden) << "fine_lr_check " << fine_lr_check;
+  }
+}

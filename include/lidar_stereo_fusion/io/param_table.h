@@ -89,6 +89,7 @@ void visitParamTable(P& p, V&& v) {
   v(ParamName{"fine_iterations", pm}, m.fine_iterations);
   v(ParamName{"fine_refine_range", pm}, m.fine_refine_range);
   v(ParamName{"fine_right_view", pm}, m.fine_right_view);
+  v(ParamName{"fine_lr_check", pm}, m.fine_lr_check);
   v(ParamName{"fine_subpixel", pm}, m.fine_subpixel);
   v(ParamName{"fine_refine", pm}, m.fine_refine);
   v(ParamName{"num_threads", pm}, m.num_threads);

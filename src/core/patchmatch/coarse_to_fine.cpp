@@ -79,5 +79,15 @@ std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::
   return planes;
 }
 
+cv::Mat1b upsampleMask(const cv::Mat1b& coarse, int scale, const cv::Size& full) {
+  cv::Mat1b out(full);
+  for (int y = 0; y < full.height; ++y) {
+    const uchar* row = coarse[std::min(coarse.rows - 1, y / scale)];
+    uchar* dst = out[y];
+    for (int x = 0; x < full.width; ++x) dst[x] = row[std::min(coarse.cols - 1, x / scale)];
+  }
+  return out;
+}
+
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion

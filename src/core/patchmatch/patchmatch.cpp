@@ -6,9 +6,10 @@
 // Per iteration: left view sweep. In the last `right_iterations` iterations also: view
 // propagation of the left planes into the right view, right view sweep, view propagation back
 // into the left (unless the right view was swept by propagation alone). Then the left-right check
-// and filling. At the full-size level after a coarse start, the right view sweeps by propagation
-// alone (fine_right_view) and the left view polishes each pixel's plane with a sub-pixel step
-// (fine_subpixel), after a random refinement only if fine_refine.
+// and filling. At the full-size level after a coarse start, the left view polishes each pixel's
+// plane with a sub-pixel step (fine_subpixel), after a random refinement only if fine_refine; the
+// right view is searched only if asked (fine_right_view, or fine_lr_check: by propagation alone),
+// else the left-right check is the 1/2-size level's, up-sampled.
 #include <algorithm>
 #include <cmath>
 #include <future>
@@ -118,7 +119,13 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   const bool two_views = p.view_propagation || p.lr_check;
 
   int iterations = p.iterations;
+  const int threads = threadCount(p);
+  const bool unmatched_bad = p.confidence_weighting && !lv.prior.empty();
   const bool guided = p.coarse_scale > 1 && std::min(size.width, size.height) >= 4 * p.coarse_scale;
+  // Whether the full-size right view is searched: without a coarse start always; after one for
+  // Bleyer's right view (fine_right_view) or a full-size left-right check (fine_lr_check).
+  bool right_view = two_views && (!guided || p.fine_right_view || (p.lr_check && p.fine_lr_check));
+  cv::Mat1b inconsistent;  // the left-right check's mask, where it is the level below's
   if (guided) {
     // Coarse start: its planes, up-sampled, are where the full-size search begins.
     if (!coarse_) coarse_ = std::make_shared<PatchMatchStereo>(coarseParams(p));
@@ -131,11 +138,21 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
       setGuide(upsamplePlanes(coarse.right_planes, p.coarse_scale, size), p, rv);
     }
     iterations = p.fine_iterations;
+    if (p.lr_check && !right_view) {
+      if (coarse.right_disparity.empty()) {
+        right_view = true;  // no view propagation below: only a full-size right view can check
+      } else {
+        const float max_diff = static_cast<float>(p.lr_max_diff / p.coarse_scale);
+        inconsistent = upsampleMask(leftRightCheck(coarse.disparity, coarse.right_disparity,
+                                                   max_diff, {}, unmatched_bad, threads),
+                                    p.coarse_scale, size);
+      }
+    }
   }
 
   // The full-size level after a coarse start polishes the planes it was given: the left view
-  // with a sub-pixel step (after random refinement if fine_refine); the right view, which then
-  // serves the left-right check only, by propagation alone unless fine_right_view.
+  // with a sub-pixel step (after random refinement if fine_refine); the right view, if searched,
+  // by propagation alone unless fine_right_view.
   SearchOptions left_options, right_options;
   left_options.subpixel = guided && p.fine_subpixel;
   left_options.refine = !guided || p.fine_refine;
@@ -145,7 +162,7 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   PlaneSearch left_search(p, lv, rv, left_options);
   PlaneSearch right_search(p, rv, lv, right_options);
   initialise(left_search, lv, p, 0);
-  if (two_views) initialise(right_search, rv, p, 1);
+  if (right_view) initialise(right_search, rv, p, 1);
   // The right view sweeps in the last `right_iterations` iterations only. It serves view
   // propagation and the left-right check; view propagation runs around its sweeps (left -> right
   // before, right -> left after), since in the other iterations the right view would only hand
@@ -154,7 +171,7 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
       p.right_iterations < 0 ? iterations : std::min(p.right_iterations, iterations);
   for (int it = 0; it < iterations; ++it) {
     sweep(left_search, lv, p, it);
-    if (!two_views || it < iterations - right_iterations) continue;
+    if (!right_view || it < iterations - right_iterations) continue;
     if (p.view_propagation) {
       // After a coarse start, the right view tries the left planes in its sweep, with the
       // windows the sweep builds anyway; Bleyer's view propagation (the coarsest level, the
@@ -173,18 +190,24 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   }
 
   PatchMatchResult result;
-  const int threads = threadCount(p);
   result.disparity = disparityOf(lv, threads);
   result.planes = planeMap(lv, threads);
-  if (two_views) {
+  if (right_view) {
     result.right_disparity = disparityOf(rv, threads);
     result.right_planes = planeMap(rv, threads);
   }
   if (p.lr_check) {
-    result.inconsistent =
-        leftRightCheck(result.disparity, result.right_disparity, static_cast<float>(p.lr_max_diff),
-                       lockedToPrior(lv), p.confidence_weighting && !lv.prior.empty(), threads);
-    fillHoles(lv, result.inconsistent.clone(), p.median_radius, static_cast<float>(p.weight_delta),
+    const std::vector<uint8_t> keep = lockedToPrior(lv);
+    if (inconsistent.empty()) {
+      inconsistent = leftRightCheck(result.disparity, result.right_disparity,
+                                    static_cast<float>(p.lr_max_diff), keep, unmatched_bad, threads);
+    } else {
+      for (size_t i = 0; i < keep.size(); ++i) {
+        if (keep[i]) inconsistent.data[i] = 0;  // the LiDAR measured it (leftRightCheck's keep)
+      }
+    }
+    result.inconsistent = inconsistent;
+    fillHoles(lv, inconsistent.clone(), p.median_radius, static_cast<float>(p.weight_delta),
               static_cast<float>(p.fill_confidence), static_cast<float>(p.max_disparity),
               result.disparity, threads);
   } else {

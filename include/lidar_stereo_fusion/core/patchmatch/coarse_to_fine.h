@@ -29,5 +29,9 @@ PatchMatchParams coarseParams(const PatchMatchParams& p);
 /// d = a x + b y + scale c - (a + b) (scale - 1) / 2.
 std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::Size& full);
 
+/// Full-size mask from a coarse level's mask: pixel (x, y) takes coarse pixel (x / scale,
+/// y / scale), as upsamplePlanes.
+cv::Mat1b upsampleMask(const cv::Mat1b& coarse, int scale, const cv::Size& full);
+
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion
