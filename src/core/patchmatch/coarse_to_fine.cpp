@@ -62,12 +62,14 @@ PatchMatchParams coarseParams(const PatchMatchParams& p) {
   return c;
 }
 
-std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::Size& full) {
+std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::Size& full,
+                                  int threads) {
   std::vector<Plane> planes(static_cast<size_t>(full.area()));
   const float s = static_cast<float>(scale);
   // Coarse pixel i covers full pixels i s .. i s + s - 1: x_c = (x - (s - 1) / 2) / s, so
   // d = s d_c(x_c, y_c) = a x + b y + s c - (a + b) (s - 1) / 2.
   const float offset = 0.5f * (s - 1.f);
+#pragma omp parallel for schedule(static) num_threads(threads)
   for (int y = 0; y < full.height; ++y) {
     const cv::Vec3f* row = coarse[std::min(coarse.rows - 1, y / scale)];
     for (int x = 0; x < full.width; ++x) {

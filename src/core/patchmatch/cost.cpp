@@ -164,6 +164,23 @@ float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, floa
                    : aggregateImpl<false>(cache, plane, bound);
 }
 
+void MatchingCost::aggregateSides(const WindowCache& cache, const Plane& plane, float h,
+                                  float& lower, float& upper) const {
+  if (avx2_) {
+    const KernelWindow w{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
+                         cache.w_lidar.data(),   cache.priors.data(), cache.texels.data()->v,
+                         cache.texel_row.data(), cache.padded,        cache.count,
+                         cache.constant};
+    aggregateSidesAvx2(w, kernel_, plane.a, plane.b, plane.c, h, lower, upper);
+    return;
+  }
+  if (use_grad_) {
+    aggregateSidesImpl<true>(cache, plane, h, lower, upper);
+  } else {
+    aggregateSidesImpl<false>(cache, plane, h, lower, upper);
+  }
+}
+
 template <bool kGrad>
 float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const {
   if (cache.constant >= bound) return cache.constant;
@@ -219,6 +236,61 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
     if (sum >= bound) return sum;
   }
   return cache.constant + laneSum(lanes);
+}
+
+template <bool kGrad>
+void MatchingCost::aggregateSidesImpl(const WindowCache& cache, const Plane& plane, float h,
+                                      float& lower, float& upper) const {
+  // aggregateImpl's operations in its order, with own - m moved by +- sign h (t1 - t0) (the
+  // AVX2 kernel's, so both paths give the same floats).
+  const float x_max = static_cast<float>(self_.width - 1);
+  const float x_clamp = x_max - 1e-3f;
+  const float* other = other_.color.ptr<float>(0);
+  const float* other_grad = kGrad ? other_.grad.ptr<float>(0) : nullptr;
+  const float sign = self_.match_sign, shift = self_.match_sign * h;
+  float lanes_lower[kSimdBlock] = {}, lanes_upper[kSimdBlock] = {};
+  for (int k = 0; k < cache.count; ++k) {
+    const float d = plane.a * cache.xs[k] + plane.b * cache.ys[k] + plane.c;
+    const float xm_raw = cache.xs[k] + sign * d;
+    const bool inside = xm_raw >= 0.f && xm_raw <= x_max;
+    const float xm = std::min(std::max(xm_raw, 0.f), x_clamp);
+    const int i0 = static_cast<int>(xm);
+    const float f = xm - static_cast<float>(i0);
+    const int idx = cache.row_offset[k] + 3 * i0;
+    const float own[3] = {cache.c0[k], cache.c1[k], cache.c2[k]};
+    float col[2] = {}, grad[2] = {};  // lower, upper
+    for (int side = 0; side < 2; ++side) {
+      float l1[3];
+      for (int ch = 0; ch < 3; ++ch) {
+        const float slope = other[idx + 3 + ch] - other[idx + ch];
+        const float diff = own[ch] - (other[idx + ch] + f * slope);
+        l1[ch] = std::abs(side == 0 ? diff + shift * slope : diff - shift * slope);
+      }
+      col[side] = l1[0] + l1[1] + l1[2];
+      if (kGrad) {
+        const int gi = (cache.row_offset[k] / 3) * 2 + 2 * i0;
+        const float own_g[2] = {cache.g0[k], cache.g1[k]};
+        float g1[2];
+        for (int ch = 0; ch < 2; ++ch) {
+          const float slope = other_grad[gi + 2 + ch] - other_grad[gi + ch];
+          const float diff = own_g[ch] - (other_grad[gi + ch] + f * slope);
+          g1[ch] = std::abs(side == 0 ? diff + shift * slope : diff - shift * slope);
+        }
+        grad[side] = g1[0] + g1[1];
+      }
+    }
+    const float dh[2] = {d - h, d + h};
+    float* lanes[2] = {lanes_lower, lanes_upper};
+    for (int side = 0; side < 2; ++side) {
+      float rho_img = wa_ * std::min(col[side], lcol_);
+      if (kGrad) rho_img += wb_ * std::min(grad[side], lgrad_);
+      if (!inside) rho_img = outside_cost_;
+      const float rho_lid = std::min(std::abs(cache.priors[k] - dh[side]), ldisp_);
+      lanes[side][k % kSimdBlock] += cache.w_img[k] * rho_img + cache.w_lidar[k] * rho_lid;
+    }
+  }
+  lower = cache.constant + laneSum(lanes_lower);
+  upper = cache.constant + laneSum(lanes_upper);
 }
 
 }  // namespace patchmatch

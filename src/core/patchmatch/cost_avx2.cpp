@@ -216,6 +216,74 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
   return w.constant + laneSum(acc);
 }
 
+void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b,
+                        float c, float h, float& lower, float& upper) {
+  const __m256 va = _mm256_set1_ps(a), vb = _mm256_set1_ps(b), vc = _mm256_set1_ps(c);
+  const __m256 sign = _mm256_set1_ps(k.sign), zero = _mm256_setzero_ps();
+  const __m256 vh = _mm256_set1_ps(h), shift = _mm256_set1_ps(k.sign * h);
+  const __m256 x_max = _mm256_set1_ps(k.x_max), x_clamp = _mm256_set1_ps(k.x_clamp);
+  const __m256 alpha = _mm256_set1_ps(k.alpha), beta = _mm256_set1_ps(k.beta);
+  const __m256 lcol = _mm256_set1_ps(k.lambda_col), lgrad = _mm256_set1_ps(k.lambda_grad);
+  const __m256 ldisp = _mm256_set1_ps(k.lambda_disp), outside = _mm256_set1_ps(k.outside_cost);
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  alignas(32) int offset[kSimdBlock];
+  alignas(32) float frac[kSimdBlock];
+  __m256 acc_lower = zero, acc_upper = zero;
+  for (int s = 0; s < w.count; s += kSimdBlock) {
+    // d's match, as aggregateAvx2.
+    const __m256 x = _mm256_loadu_ps(w.xs + s);
+    const __m256 y = _mm256_loadu_ps(w.ys + s);
+    const __m256 d = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(va, x), _mm256_mul_ps(vb, y)), vc);
+    const __m256 xm_raw = _mm256_add_ps(x, _mm256_mul_ps(sign, d));
+    const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(xm_raw, zero, _CMP_GE_OQ),
+                                        _mm256_cmp_ps(xm_raw, x_max, _CMP_LE_OQ));
+    const __m256 xm = _mm256_min_ps(_mm256_max_ps(xm_raw, zero), x_clamp);
+    const __m256i i0 = _mm256_cvttps_epi32(xm);
+    _mm256_store_ps(frac, _mm256_sub_ps(xm, _mm256_cvtepi32_ps(i0)));
+    const __m256i row = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(w.texel_row + s));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(offset),
+                       _mm256_add_epi32(row, _mm256_slli_epi32(i0, 3)));
+    // own - m at d -+ h: own - m +- sign h (t1 - t0), on the interval of d's match.
+    __m256 dk_lower[kSimdBlock], dk_upper[kSimdBlock];
+    const float* own = w.texels + s * kTexelFloats;
+    for (int j = 0; j < kSimdBlock; ++j) {
+      const float* t = k.other_texels + offset[j];
+      const __m256 t0 = _mm256_load_ps(t);
+      const __m256 slope = _mm256_sub_ps(_mm256_load_ps(t + kTexelFloats), t0);
+      const __m256 m = _mm256_add_ps(t0, _mm256_mul_ps(_mm256_broadcast_ss(frac + j), slope));
+      const __m256 diff = _mm256_sub_ps(_mm256_loadu_ps(own + j * kTexelFloats), m);
+      const __m256 moved = _mm256_mul_ps(shift, slope);
+      dk_lower[j] = _mm256_and_ps(abs_mask, _mm256_add_ps(diff, moved));
+      dk_upper[j] = _mm256_and_ps(abs_mask, _mm256_sub_ps(diff, moved));
+    }
+    __m256 col_lower, grad_lower, col_upper, grad_upper;
+    channelSums(dk_lower, col_lower, grad_lower);
+    channelSums(dk_upper, col_upper, grad_upper);
+    const __m256 rho_lower = _mm256_blendv_ps(
+        outside,
+        _mm256_add_ps(_mm256_mul_ps(alpha, _mm256_min_ps(col_lower, lcol)),
+                      _mm256_mul_ps(beta, _mm256_min_ps(grad_lower, lgrad))),
+        inside);
+    const __m256 rho_upper = _mm256_blendv_ps(
+        outside,
+        _mm256_add_ps(_mm256_mul_ps(alpha, _mm256_min_ps(col_upper, lcol)),
+                      _mm256_mul_ps(beta, _mm256_min_ps(grad_upper, lgrad))),
+        inside);
+    const __m256 prior = _mm256_loadu_ps(w.priors + s);
+    const __m256 w_img = _mm256_loadu_ps(w.w_img + s), w_lidar = _mm256_loadu_ps(w.w_lidar + s);
+    const __m256 lid_lower =
+        _mm256_min_ps(_mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_sub_ps(d, vh))), ldisp);
+    const __m256 lid_upper =
+        _mm256_min_ps(_mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_add_ps(d, vh))), ldisp);
+    acc_lower = _mm256_add_ps(acc_lower, _mm256_add_ps(_mm256_mul_ps(w_img, rho_lower),
+                                                       _mm256_mul_ps(w_lidar, lid_lower)));
+    acc_upper = _mm256_add_ps(acc_upper, _mm256_add_ps(_mm256_mul_ps(w_img, rho_upper),
+                                                       _mm256_mul_ps(w_lidar, lid_upper)));
+  }
+  lower = w.constant + laneSum(acc_lower);
+  upper = w.constant + laneSum(acc_upper);
+}
+
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion
 
@@ -235,6 +303,11 @@ int buildWindowAvx2(const KernelSelf&, int, int, const KernelWindowOut&, int& pa
   padded = 0;
   constant = 0.f;
   return 0;
+}
+
+void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants&, float, float, float, float,
+                        float& lower, float& upper) {
+  lower = upper = w.constant;
 }
 
 }  // namespace patchmatch

@@ -132,10 +132,10 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     coarse_->setParams(coarseParams(p));
     const PatchMatchResult coarse = coarse_->compute(downsampleView(left, p.coarse_scale),
                                                      downsampleView(right, p.coarse_scale));
-    setGuide(upsamplePlanes(coarse.planes, p.coarse_scale, size), p, lv);
+    setGuide(upsamplePlanes(coarse.planes, p.coarse_scale, size, threads), p, lv);
     // The coarse level has no left-right check, so without view propagation it has no right view.
-    if (two_views && !coarse.right_planes.empty()) {
-      setGuide(upsamplePlanes(coarse.right_planes, p.coarse_scale, size), p, rv);
+    if (right_view && !coarse.right_planes.empty()) {
+      setGuide(upsamplePlanes(coarse.right_planes, p.coarse_scale, size, threads), p, rv);
     }
     iterations = p.fine_iterations;
     if (p.lr_check && !right_view) {

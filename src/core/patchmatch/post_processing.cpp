@@ -6,55 +6,43 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <utility>
 #include <vector>
+
+#include "lidar_stereo_fusion/core/patchmatch/median_kernel.h"
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
 namespace {
 
-/// A window sample of the weighted median: disparity and weight.
-struct Weighted {
-  float d, w;
-};
-
-/// The colour-weighted median of s[i], i < n: the smallest d whose cumulative weight in
-/// ascending order of d reaches `half` (half the total weight). A three-way quickselect, O(n) on
-/// average; s is reordered.
-float weightedMedian(Weighted* s, int n, float half) {
-  int lo = 0, hi = n;  // the answer is among [lo, hi)
-  float pivot = s[0].d;
-  while (hi - lo > 1) {
-    const float a = s[lo].d, b = s[lo + (hi - lo) / 2].d, c = s[hi - 1].d;
-    pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));  // median of three
-    // [lo, lt) < pivot, [lt, gt) == pivot, [gt, hi) > pivot.
-    int lt = lo, i = lo, gt = hi;
-    float w_less = 0.f, w_equal = 0.f;
-    while (i < gt) {
-      if (s[i].d < pivot) {
-        std::swap(s[i], s[lt]);
-        w_less += s[lt].w;
-        ++lt;
-        ++i;
-      } else if (s[i].d > pivot) {
-        --gt;
-        std::swap(s[i], s[gt]);
-      } else {
-        w_equal += s[i].w;
-        ++i;
-      }
+/// The colour-weighted median of d[i], i < n: the smallest d[i] whose cumulative weight, the sum
+/// of w[j] over d[j] <= d[i], reaches `half` (half the total weight). Each candidate's sum runs
+/// over every sample in window order, kMedianLanes candidates side by side, without branches:
+/// for the few dozen samples of a window faster than a quickselect, whose branches the data
+/// decide (with AVX2 where the CPU has it: the same floats). The arrays have room for n rounded
+/// up to kMedianLanes; the padding is written here.
+float weightedMedian(float* d, float* w, int n, float half, bool avx2) {
+  const int padded = (n + kMedianLanes - 1) / kMedianLanes * kMedianLanes;
+  // Padding: the largest value, and the largest real sample always qualifies (its sum is all).
+  for (int i = n; i < padded; ++i) {
+    d[i] = std::numeric_limits<float>::max();
+    w[i] = 0.f;
+  }
+  if (avx2) return weightedMedianAvx2(d, w, n, padded, half);
+  float best = std::numeric_limits<float>::max();
+  for (int i0 = 0; i0 < padded; i0 += kMedianLanes) {
+    const float* candidate = d + i0;
+    float cumulative[kMedianLanes] = {};
+    for (int j = 0; j < n; ++j) {
+      const float dj = d[j], wj = w[j];
+      for (int k = 0; k < kMedianLanes; ++k) cumulative[k] += dj <= candidate[k] ? wj : 0.f;
     }
-    if (w_less >= half && lt > lo) {
-      hi = lt;
-    } else if (w_less + w_equal >= half || gt == hi) {
-      return pivot;
-    } else {
-      half -= w_less + w_equal;
-      lo = gt;
+    for (int k = 0; k < kMedianLanes; ++k) {
+      if (cumulative[k] >= half && candidate[k] < best) best = candidate[k];
     }
   }
-  return hi - lo == 1 ? s[lo].d : pivot;
+  return best;
 }
 
 }  // namespace
@@ -136,9 +124,12 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
   for (size_t i = 0; i < lut.size(); ++i) lut[i] = std::exp(-static_cast<float>(i) / delta);
   filled.copyTo(disparity);  // same size: no new allocation
   const int lut_last = static_cast<int>(lut.size()) - 1;
+  const bool avx2 = activeSimdPath() == SimdPath::kAvx2;
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
-    std::vector<Weighted> samples((radius + 1) * (radius + 1));  // radius / 2 + 1 per axis
+    // At most radius + 1 samples per axis (every second of 2 radius + 1), and the padding.
+    const int most = (radius + 1) * (radius + 1);
+    std::vector<float> ds(most + kMedianLanes), ws(most + kMedianLanes);
     for (int x = 0; x < v.width; ++x) {
       if (!bad(y, x)) continue;
       const cv::Vec3f& c = v.color(y, x);
@@ -155,11 +146,12 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
           const int l1 = static_cast<int>(std::abs(q[0] - c[0]) + std::abs(q[1] - c[1]) +
                                           std::abs(q[2] - c[2]));
           const float w = lut[std::min(l1, lut_last)];
-          samples[n++] = Weighted{d, w};
+          ds[n] = d;
+          ws[n++] = w;
           total += w;
         }
       }
-      if (n > 0) disparity(y, x) = weightedMedian(samples.data(), n, 0.5f * total);
+      if (n > 0) disparity(y, x) = weightedMedian(ds.data(), ws.data(), n, 0.5f * total, avx2);
     }
   }
 }

@@ -197,21 +197,23 @@ void PlaneSearch::subpixelStep(int x, int y, const WindowCache& cache, Plane& be
   const float fx = static_cast<float>(x), fy = static_cast<float>(y);
   const Plane lower{best.a, best.b, best.c - h}, upper{best.a, best.b, best.c + h};
   if (!admissible(x, y, lower.at(fx, fy)) || !admissible(x, y, upper.at(fx, fy))) return;
-  const float unbounded = std::numeric_limits<float>::max();  // the fit needs the full costs
-  const float c_lower = cost_.aggregate(cache, lower, unbounded);
-  const float c_upper = cost_.aggregate(cache, upper, unbounded);
+  // The costs at d -+ h in one pass, with each sample's match interpolated on the interval of
+  // d's (MatchingCost::aggregateSides): the fit needs the full costs, and two evaluations would
+  // cost half as much again.
+  float c_lower, c_upper;
+  cost_.aggregateSides(cache, best, h, c_lower, c_upper);
   // The steeper side's slope is the V's: rise over h.
   const float rise = std::max(c_lower, c_upper) - best_cost;
   const float vertex = rise > 0.f ? 0.5f * h * (c_lower - c_upper) / rise : 0.f;
   if (!(rise > 0.f) || !(std::abs(vertex) <= h)) {
-    // No V with its vertex between the two: keep the cheapest of the three.
-    if (c_lower < best_cost) {
+    // No V with its vertex between the two: keep the cheapest of the three, whose cost is
+    // computed if ever asked for (the sides are C only where the other view is linear).
+    if (c_lower < best_cost && c_lower <= c_upper) {
       best = lower;
-      best_cost = c_lower;
-    }
-    if (c_upper < best_cost) {
+      best_cost = kUnknownCost;
+    } else if (c_upper < best_cost) {
       best = upper;
-      best_cost = c_upper;
+      best_cost = kUnknownCost;
     }
     return;
   }

@@ -26,8 +26,9 @@ PatchMatchParams coarseParams(const PatchMatchParams& p);
 /// Full-size planes from the coarse level's plane map (a, b, c) per coarse pixel: pixel (x, y)
 /// takes the plane of coarse pixel (x / scale, y / scale), which at full size (coarse pixel
 /// centres at full-size coordinate i scale + (scale - 1) / 2) is
-/// d = a x + b y + scale c - (a + b) (scale - 1) / 2.
-std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::Size& full);
+/// d = a x + b y + scale c - (a + b) (scale - 1) / 2. Rows run on `threads` threads.
+std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::Size& full,
+                                  int threads = 1);
 
 /// Full-size mask from a coarse level's mask: pixel (x, y) takes coarse pixel (x / scale,
 /// y / scale), as upsamplePlanes.

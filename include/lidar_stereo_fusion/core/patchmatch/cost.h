@@ -64,6 +64,13 @@ class MatchingCost {
   /// partial sum exceeds `bound`; exact otherwise.
   float aggregate(const WindowCache& cache, const Plane& plane, float bound) const;
 
+  /// The costs of the planes d - h and d + h (plane.c -+ h) for the sub-pixel step, in one pass
+  /// over the window: each sample's match is interpolated on the interval of its match under the
+  /// plane itself (linear in the shift), so they are C exactly where the other view is linear
+  /// between its pixels, and within h times a slope change of it elsewhere.
+  void aggregateSides(const WindowCache& cache, const Plane& plane, float h, float& lower,
+                      float& upper) const;
+
   /// Whether this cost runs the AVX2 kernel.
   bool usesAvx2() const { return avx2_; }
 
@@ -73,6 +80,9 @@ class MatchingCost {
  private:
   template <bool kGrad>
   float aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const;
+  template <bool kGrad>
+  void aggregateSidesImpl(const WindowCache& cache, const Plane& plane, float h, float& lower,
+                          float& upper) const;
 
   static constexpr int kLutSize = 4096;
   static constexpr float kLutScale = 4.f;  ///< LUT entries per unit of RGB L1 distance

@@ -85,5 +85,11 @@ extern const bool kAvx2KernelBuilt;
 float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b, float c,
                     float bound);
 
+/// The costs of the planes d - h and d + h (c -+ h), each sample's match interpolated on the
+/// interval of d's match (linear in the shift, exact where the other view is linear there), in
+/// one pass: MatchingCost::aggregateSides. Summed like C, no bound. Call only with AVX2 + FMA.
+void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b,
+                        float c, float h, float& lower, float& upper);
+
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion
