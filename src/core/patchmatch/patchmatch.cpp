@@ -130,8 +130,19 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     // Coarse start: its planes, up-sampled, are where the full-size search begins.
     if (!coarse_) coarse_ = std::make_shared<PatchMatchStereo>(coarseParams(p));
     coarse_->setParams(coarseParams(p));
-    const PatchMatchResult coarse = coarse_->compute(downsampleView(left, p.coarse_scale),
-                                                     downsampleView(right, p.coarse_scale));
+    ViewInput coarse_left, coarse_right;
+    {
+      std::future<void> right_ready;  // the two views reduced side by side, as prepared
+      if (threads > 1) {
+        right_ready = std::async(std::launch::async,
+                                 [&] { coarse_right = downsampleView(right, p.coarse_scale); });
+      } else {
+        coarse_right = downsampleView(right, p.coarse_scale);
+      }
+      coarse_left = downsampleView(left, p.coarse_scale);
+      if (right_ready.valid()) right_ready.get();
+    }
+    const PatchMatchResult coarse = coarse_->compute(coarse_left, coarse_right);
     setGuide(upsamplePlanes(coarse.planes, p.coarse_scale, size, threads), p, lv);
     // The coarse level has no left-right check, so without view propagation it has no right view.
     if (right_view && !coarse.right_planes.empty()) {

@@ -69,7 +69,8 @@ void prepareTexels(ViewState& v) {
     v.texels.clear();
     return;
   }
-  v.texels.assign(static_cast<size_t>(v.width) * v.height, Texel{});
+  // Every entry is written below: the buffer of the previous frame is reused as it is.
+  v.texels.resize(static_cast<size_t>(v.width) * v.height);
   for (int y = 0; y < v.height; ++y) {
     const cv::Vec3f* crow = v.color.ptr<cv::Vec3f>(y);
     const cv::Vec2f* grow = v.grad.empty() ? nullptr : v.grad.ptr<cv::Vec2f>(y);
@@ -79,10 +80,11 @@ void prepareTexels(ViewState& v) {
       t[0] = crow[x][0];
       t[1] = crow[x][1];
       t[2] = crow[x][2];
-      if (grow != nullptr) {
-        t[4] = grow[x][0];
-        t[5] = grow[x][1];
-      }
+      t[3] = 0.f;
+      t[4] = grow != nullptr ? grow[x][0] : 0.f;
+      t[5] = grow != nullptr ? grow[x][1] : 0.f;
+      t[6] = 0.f;
+      t[7] = 0.f;
     }
   }
 }
@@ -159,10 +161,12 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
   v.range = in.bounds.range;
   imageRange(in, p, v.d_min, v.d_max);
   const size_t n = static_cast<size_t>(v.width) * v.height;
-  v.planes.assign(n, Plane{});
-  v.cost.assign(n, 0.f);
+  // Planes, costs and offers are written before they are read (initialise, offerView): the
+  // previous frame's buffers are reused as they are; flags start cleared.
+  v.planes.resize(n);
+  v.cost.resize(n);
   v.locked.assign(n, 0);
-  v.offer.assign(n, Plane{});
+  v.offer.resize(n);
   v.offered.assign(n, 0);
   v.guide.clear();
   const float lock = static_cast<float>(p.lock_confidence);
