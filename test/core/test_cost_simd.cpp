@@ -12,6 +12,7 @@
 
 #include "lidar_stereo_fusion/core/patchmatch.h"
 #include "lidar_stereo_fusion/core/patchmatch/cost.h"
+#include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
 #include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/patchmatch/view_state.h"
 #include "test_scenes.h"
@@ -60,7 +61,8 @@ void randomPrior(int w, int h, std::mt19937& rng, cv::Mat1f& prior, cv::Mat1f& c
   }
 }
 
-/// C(p, plane) of cost.h in double precision, straight from the equations. w is the
+/// C(p, plane) of cost.h in double precision, straight from the equations, on the view's texels
+/// (colour and gradient in the kernels' fixed point, the match interpolated as they do). w is the
 /// implementation's: exp(-l / delta) with l the RGB L1 distance rounded down to 1/4 (its LUT).
 /// Whether the window uses offset o: a multiple of the stride, and with dyadic sampling 0 or the
 /// stride times a power of two.
@@ -90,17 +92,20 @@ double referenceCost(const lsf::PatchMatchParams& p, const pm::ViewState& self,
       const double xm = x + self.match_sign * d;
       double rho_img = alpha * p.lambda_col + beta * p.lambda_grad;  // match outside the image
       if (xm >= 0 && xm <= other.width - 1) {
+        // The texels' fixed point (cost_kernel.h): the nodes to 1/kTexelScale, the fraction to
+        // 2^-15, m rounded to 1/kTexelScale.
         const int x0 = std::min(static_cast<int>(xm), other.width - 2);
-        const double f = xm - x0;
-        double col = 0, grad = 0;
-        for (int i = 0; i < 3; ++i) {
-          const double m = (1 - f) * other.color(y, x0)[i] + f * other.color(y, x0 + 1)[i];
-          col += std::abs(c[i] - m);
+        const int fq =
+            std::min(pm::kFracOne - 1, static_cast<int>(std::lround((xm - x0) * pm::kFracOne)));
+        const short* t0 = other.texels[static_cast<size_t>(y) * other.width + x0].v;
+        const short* t1 = t0 + pm::kTexelChannels;
+        const short* own = self.texels[static_cast<size_t>(y) * self.width + x].v;
+        double l1[pm::kTexelChannels];
+        for (int i = 0; i < pm::kTexelChannels; ++i) {
+          const double m = t0[i] + std::floor((t1[i] - t0[i]) * double(fq) / pm::kFracOne + 0.5);
+          l1[i] = std::abs(own[i] - m) / pm::kTexelScale;
         }
-        for (int i = 0; i < 2 && beta > 0; ++i) {
-          const double m = (1 - f) * other.grad(y, x0)[i] + f * other.grad(y, x0 + 1)[i];
-          grad += std::abs(self.grad(y, x)[i] - m);
-        }
+        const double col = l1[0] + l1[1] + l1[2], grad = beta > 0 ? l1[4] + l1[5] : 0.0;
         rho_img = alpha * std::min(col, p.lambda_col) + beta * std::min(grad, p.lambda_grad);
       }
       const double prior = use_prior ? self.prior(y, x) : 0.0;

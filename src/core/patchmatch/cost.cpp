@@ -35,8 +35,7 @@ std::vector<int> windowOffsets(int radius, int stride, bool dyadic) {
 }
 
 void WindowCache::reserve(size_t n) {
-  for (auto* v : {&xs, &ys, &w_img, &w_lidar, &c0, &c1, &c2, &g0, &g1, &priors}) v->assign(n, 0.f);
-  row_offset.assign(n, 0);
+  for (auto* v : {&xs, &ys, &w_img, &w_lidar, &priors}) v->assign(n, 0.f);
   texels.assign(n, Texel{});
   texel_row.assign(n, 0);
 }
@@ -60,16 +59,16 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   use_prior_ = wg_ > 0.f && !self_.prior.empty();
   weighted_ = p_.confidence_weighting;
   img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
-  avx2_ = activeSimdPath() == SimdPath::kAvx2 && !self_.texels.empty() && !other_.texels.empty();
+  avx2_ = activeSimdPath() == SimdPath::kAvx2;
   const float x_max = static_cast<float>(self_.width - 1);
-  kernel_self_ = KernelSelf{self_.texels.data()->v,
+  kernel_self_ = KernelSelf{self_.texels.empty() ? nullptr : self_.texels.data()->v,
                             use_prior_ ? self_.prior.ptr<float>(0) : nullptr,
                             use_prior_ ? self_.trust.ptr<float>(0) : nullptr,
                             use_prior_ ? static_cast<int>(self_.prior.step1()) : 0,
                             use_prior_ ? static_cast<int>(self_.trust.step1()) : 0,
                             self_.width,
                             self_.height,
-                            kTexelFloats * other_.width,
+                            kTexelChannels * other_.width,
                             offsets_.data(),
                             static_cast<int>(offsets_.size()),
                             weight_lut_.data(),
@@ -79,14 +78,17 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
                             wg_,
                             img_norm_,
                             ldisp_};
-  kernel_ = KernelConstants{other_.texels.data()->v,
+  // The L1 sums are in texel units: alpha min(L1 / 64, lambda) = alpha / 64 min(L1, 64 lambda),
+  // exactly (powers of two).
+  const float scale = static_cast<float>(kTexelScale);
+  kernel_ = KernelConstants{other_.texels.empty() ? nullptr : other_.texels.data()->v,
                             x_max,
                             x_max - 1e-3f,
                             self_.match_sign,
-                            wa_,
-                            use_grad_ ? wb_ : 0.f,
-                            lcol_,
-                            lgrad_,
+                            wa_ / scale,
+                            use_grad_ ? wb_ / scale : 0.f,
+                            lcol_ * scale,
+                            lgrad_ * scale,
                             ldisp_,
                             outside_cost_};
 }
@@ -107,31 +109,27 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
   }
   cache.constant = 0.f;
   int k = 0;
-  const cv::Vec3f center = self_.color(py, px);
-  const int color_stride = 3 * other_.width;
+  const short* texels = self_.texels.data()->v;
+  const short* center = texels + (static_cast<long>(py) * self_.width + px) * kTexelChannels;
+  const float lut_step = kLutScale / static_cast<float>(kTexelScale);  // per texel unit of L1
+  const float lut_last = static_cast<float>(kLutSize - 1);
   for (int dy : offsets_) {
     const int y = py + dy;
     if (y < 0 || y >= self_.height) continue;
-    const cv::Vec3f* crow = self_.color.ptr<cv::Vec3f>(y);
-    const cv::Vec2f* grow = use_grad_ ? self_.grad.ptr<cv::Vec2f>(y) : nullptr;
     const float* prow = use_prior_ ? self_.prior.ptr<float>(y) : nullptr;
     const float* trow = use_prior_ ? self_.trust.ptr<float>(y) : nullptr;
     for (int dx : offsets_) {
       const int x = px + dx;
       if (x < 0 || x >= self_.width) continue;
-      const cv::Vec3f& c = crow[x];
-      const float w = supportWeight(std::abs(c[0] - center[0]) + std::abs(c[1] - center[1]) +
-                                    std::abs(c[2] - center[2]));
+      const Texel& t = self_.texels[static_cast<size_t>(y) * self_.width + x];
+      const int l1 = std::abs(t.v[0] - center[0]) + std::abs(t.v[1] - center[1]) +
+                     std::abs(t.v[2] - center[2]);
+      const float w = weight_lut_[static_cast<int>(std::min(static_cast<float>(l1) * lut_step,
+                                                            lut_last))];
       cache.xs[k] = static_cast<float>(x);
       cache.ys[k] = static_cast<float>(y);
-      cache.c0[k] = c[0];
-      cache.c1[k] = c[1];
-      cache.c2[k] = c[2];
-      cache.row_offset[k] = y * color_stride;
-      if (use_grad_) {
-        cache.g0[k] = grow[x][0];
-        cache.g1[k] = grow[x][1];
-      }
+      cache.texels[k] = t;
+      cache.texel_row[k] = y * kTexelChannels * other_.width;
       const float trust = use_prior_ ? trow[x] : 0.f;
       cache.priors[k] = use_prior_ ? prow[x] : 0.f;
       if (weighted_) {
@@ -160,47 +158,55 @@ float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, floa
                          cache.constant};
     return aggregateAvx2(w, kernel_, plane.a, plane.b, plane.c, bound);
   }
-  return use_grad_ ? aggregateImpl<true>(cache, plane, bound)
-                   : aggregateImpl<false>(cache, plane, bound);
+  return aggregateImpl(cache, plane, bound);
 }
 
 void MatchingCost::aggregateSides(const WindowCache& cache, const Plane& plane, float h,
                                   float& lower, float& upper) const {
+  // The match's move by sign h in the fixed point of the interpolation fraction.
+  const int shift_q = static_cast<int>(std::lround(self_.match_sign * h * kFracOne));
   if (avx2_) {
     const KernelWindow w{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
                          cache.w_lidar.data(),   cache.priors.data(), cache.texels.data()->v,
                          cache.texel_row.data(), cache.padded,        cache.count,
                          cache.constant};
-    aggregateSidesAvx2(w, kernel_, plane.a, plane.b, plane.c, h, lower, upper);
+    aggregateSidesAvx2(w, kernel_, plane.a, plane.b, plane.c, h, shift_q, lower, upper);
     return;
   }
-  if (use_grad_) {
-    aggregateSidesImpl<true>(cache, plane, h, lower, upper);
-  } else {
-    aggregateSidesImpl<false>(cache, plane, h, lower, upper);
-  }
+  aggregateSidesImpl(cache, plane, h, shift_q, lower, upper);
 }
 
-template <bool kGrad>
+namespace {
+
+/// _mm256_mulhrs_epi16 of one lane: round(a b / 2^15).
+inline int mulhrs(int a, int b) { return (a * b + (1 << 14)) >> 15; }
+
+/// Where sample k's plane disparity d matches in the other view, as both kernels compute it:
+/// `inside` the image, the left node's offset in the other view's texels [shorts] and the
+/// fraction in fixed point.
+struct Match {
+  bool inside;
+  int node;
+  int frac_q;
+};
+
+inline Match matchOf(float x, float d, float sign, float x_max, float x_clamp, int row) {
+  const float xm_raw = x + sign * d;
+  const float xm = std::min(std::max(xm_raw, 0.f), x_clamp);  // keeps i0 + 1 inside the row
+  const int i0 = static_cast<int>(xm);
+  // round(f 2^15) to nearest even (the kernel's conversion), at most 2^15 - 1 (its saturation).
+  const float f = xm - static_cast<float>(i0);
+  const int frac_q = std::min(kFracOne - 1, static_cast<int>(std::nearbyint(f * kFracOne)));
+  return Match{xm_raw >= 0.f && xm_raw <= x_max, row + i0 * kTexelChannels, frac_q};
+}
+
+}  // namespace
+
 float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const {
   if (cache.constant >= bound) return cache.constant;
   const float x_max = static_cast<float>(self_.width - 1);
-  const float x_clamp = x_max - 1e-3f;  // keeps i0 + 1 inside the row
-  const float* other = other_.color.ptr<float>(0);
-  const float* other_grad = kGrad ? other_.grad.ptr<float>(0) : nullptr;
-  const float sign = self_.match_sign;
-  const float a = plane.a, b = plane.b, c = plane.c;
-  const float* xs = cache.xs.data();
-  const float* ys = cache.ys.data();
-  const float* wi = cache.w_img.data();
-  const float* wl = cache.w_lidar.data();
-  const float* c0 = cache.c0.data();
-  const float* c1 = cache.c1.data();
-  const float* c2 = cache.c2.data();
-  const float* g0 = cache.g0.data();
-  const float* g1 = cache.g1.data();
-  const float* pr = cache.priors.data();
-  const int* ro = cache.row_offset.data();
+  const short* other = other_.texels.data()->v;
+  const KernelConstants& kc = kernel_;
   // Terms are summed in kSimdBlock lanes (sample k into lane k % 8), the lanes reduced by
   // laneSum(), and the bound checked after every block of 8 samples: the AVX2 kernel's order, so
   // both return the same float. Most refinement candidates are worse than the current plane and
@@ -209,28 +215,22 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
   for (int start = 0; start < cache.count; start += kSimdBlock) {
     const int end = std::min(cache.count, start + kSimdBlock);
     for (int k = start; k < end; ++k) {
-      const float d = a * xs[k] + b * ys[k] + c;
-      const float xm_raw = xs[k] + sign * d;
-      const float inside = (xm_raw >= 0.f && xm_raw <= x_max) ? 1.f : 0.f;
-      const float xm = std::min(std::max(xm_raw, 0.f), x_clamp);
-      const int i0 = static_cast<int>(xm);
-      const float f = xm - static_cast<float>(i0);
-      const int idx = ro[k] + 3 * i0;
-      // Colour of q by linear interpolation (sub-pixel match).
-      const float m0 = other[idx] + f * (other[idx + 3] - other[idx]);
-      const float m1 = other[idx + 1] + f * (other[idx + 4] - other[idx + 1]);
-      const float m2 = other[idx + 2] + f * (other[idx + 5] - other[idx + 2]);
-      const float col = std::abs(c0[k] - m0) + std::abs(c1[k] - m1) + std::abs(c2[k] - m2);
-      float rho_img = wa_ * std::min(col, lcol_);
-      if (kGrad) {
-        const int gi = (ro[k] / 3) * 2 + 2 * i0;
-        const float h0 = other_grad[gi] + f * (other_grad[gi + 2] - other_grad[gi]);
-        const float h1 = other_grad[gi + 1] + f * (other_grad[gi + 3] - other_grad[gi + 1]);
-        rho_img += wb_ * std::min(std::abs(g0[k] - h0) + std::abs(g1[k] - h1), lgrad_);
+      const float d = plane.a * cache.xs[k] + plane.b * cache.ys[k] + plane.c;
+      const Match m = matchOf(cache.xs[k], d, kc.sign, x_max, kc.x_clamp, cache.texel_row[k]);
+      // The match's texel by linear interpolation (sub-pixel match), in fixed point.
+      const short* t0 = other + m.node;
+      const short* own = cache.texels[k].v;
+      int l1[kTexelChannels];
+      for (int c = 0; c < kTexelChannels; ++c) {
+        l1[c] = std::abs(own[c] - (t0[c] + mulhrs(t0[kTexelChannels + c] - t0[c], m.frac_q)));
       }
-      rho_img = inside * rho_img + (1.f - inside) * outside_cost_;
-      const float rho_lid = std::min(std::abs(pr[k] - d), ldisp_);
-      lanes[k - start] += wi[k] * rho_img + wl[k] * rho_lid;
+      const float col = static_cast<float>((l1[0] + l1[1]) + l1[2]);
+      const float grad = static_cast<float>(l1[4] + l1[5]);
+      float rho_img = kc.alpha * std::min(col, kc.lambda_col) +
+                      kc.beta * std::min(grad, kc.lambda_grad);
+      if (!m.inside) rho_img = kc.outside_cost;
+      const float rho_lid = std::min(std::abs(cache.priors[k] - d), kc.lambda_disp);
+      lanes[k - start] += cache.w_img[k] * rho_img + cache.w_lidar[k] * rho_lid;
     }
     const float sum = cache.constant + laneSum(lanes);
     if (sum >= bound) return sum;
@@ -238,54 +238,38 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
   return cache.constant + laneSum(lanes);
 }
 
-template <bool kGrad>
 void MatchingCost::aggregateSidesImpl(const WindowCache& cache, const Plane& plane, float h,
-                                      float& lower, float& upper) const {
-  // aggregateImpl's operations in its order, with own - m moved by +- sign h (t1 - t0) (the
-  // AVX2 kernel's, so both paths give the same floats).
+                                      int shift_q, float& lower, float& upper) const {
+  // aggregateImpl's operations in its order, with own - m moved by -+ the interpolation step's
+  // share of the shift (the AVX2 kernel's, so both paths give the same floats).
   const float x_max = static_cast<float>(self_.width - 1);
-  const float x_clamp = x_max - 1e-3f;
-  const float* other = other_.color.ptr<float>(0);
-  const float* other_grad = kGrad ? other_.grad.ptr<float>(0) : nullptr;
-  const float sign = self_.match_sign, shift = self_.match_sign * h;
+  const short* other = other_.texels.data()->v;
+  const KernelConstants& kc = kernel_;
   float lanes_lower[kSimdBlock] = {}, lanes_upper[kSimdBlock] = {};
   for (int k = 0; k < cache.count; ++k) {
     const float d = plane.a * cache.xs[k] + plane.b * cache.ys[k] + plane.c;
-    const float xm_raw = cache.xs[k] + sign * d;
-    const bool inside = xm_raw >= 0.f && xm_raw <= x_max;
-    const float xm = std::min(std::max(xm_raw, 0.f), x_clamp);
-    const int i0 = static_cast<int>(xm);
-    const float f = xm - static_cast<float>(i0);
-    const int idx = cache.row_offset[k] + 3 * i0;
-    const float own[3] = {cache.c0[k], cache.c1[k], cache.c2[k]};
-    float col[2] = {}, grad[2] = {};  // lower, upper
-    for (int side = 0; side < 2; ++side) {
-      float l1[3];
-      for (int ch = 0; ch < 3; ++ch) {
-        const float slope = other[idx + 3 + ch] - other[idx + ch];
-        const float diff = own[ch] - (other[idx + ch] + f * slope);
-        l1[ch] = std::abs(side == 0 ? diff + shift * slope : diff - shift * slope);
-      }
-      col[side] = l1[0] + l1[1] + l1[2];
-      if (kGrad) {
-        const int gi = (cache.row_offset[k] / 3) * 2 + 2 * i0;
-        const float own_g[2] = {cache.g0[k], cache.g1[k]};
-        float g1[2];
-        for (int ch = 0; ch < 2; ++ch) {
-          const float slope = other_grad[gi + 2 + ch] - other_grad[gi + ch];
-          const float diff = own_g[ch] - (other_grad[gi + ch] + f * slope);
-          g1[ch] = std::abs(side == 0 ? diff + shift * slope : diff - shift * slope);
-        }
-        grad[side] = g1[0] + g1[1];
-      }
+    const Match m = matchOf(cache.xs[k], d, kc.sign, x_max, kc.x_clamp, cache.texel_row[k]);
+    const short* t0 = other + m.node;
+    const short* own = cache.texels[k].v;
+    int l1_lower[kTexelChannels], l1_upper[kTexelChannels];
+    for (int c = 0; c < kTexelChannels; ++c) {
+      const int slope = t0[kTexelChannels + c] - t0[c];
+      const int diff = own[c] - (t0[c] + mulhrs(slope, m.frac_q));
+      const int moved = mulhrs(slope, shift_q);
+      l1_lower[c] = std::abs(diff + moved);
+      l1_upper[c] = std::abs(diff - moved);
     }
+    const int* l1s[2] = {l1_lower, l1_upper};
     const float dh[2] = {d - h, d + h};
     float* lanes[2] = {lanes_lower, lanes_upper};
     for (int side = 0; side < 2; ++side) {
-      float rho_img = wa_ * std::min(col[side], lcol_);
-      if (kGrad) rho_img += wb_ * std::min(grad[side], lgrad_);
-      if (!inside) rho_img = outside_cost_;
-      const float rho_lid = std::min(std::abs(cache.priors[k] - dh[side]), ldisp_);
+      const int* l1 = l1s[side];
+      const float col = static_cast<float>((l1[0] + l1[1]) + l1[2]);
+      const float grad = static_cast<float>(l1[4] + l1[5]);
+      float rho_img = kc.alpha * std::min(col, kc.lambda_col) +
+                      kc.beta * std::min(grad, kc.lambda_grad);
+      if (!m.inside) rho_img = kc.outside_cost;
+      const float rho_lid = std::min(std::abs(cache.priors[k] - dh[side]), kc.lambda_disp);
       lanes[side][k % kSimdBlock] += cache.w_img[k] * rho_img + cache.w_lidar[k] * rho_lid;
     }
   }

@@ -3,12 +3,13 @@
 // has both (simd.h); no FMA instruction is used, so that results stay the baseline's.
 // Includes nothing but intrinsics and the plain-data kernel interface (see cost_kernel.h).
 //
-// Per block of 8 samples: the disparity d, the match x_q and its interpolation weight f are
-// computed as vectors; then, per sample, the two texels around x_q (B, G, R, 0, gx, gy, 0, 0) are
-// loaded as two 8-float vectors, interpolated and compared with the sample's own
-// texel; a tree of horizontal adds turns the 8 per-sample difference vectors into the colour L1
-// and gradient L1 of the 8 samples; the 8 terms are added to 8 lane sums. Every float operation
-// is the baseline's, in its order (no FMA contraction, the lanes and their reduction as in
+// Per block of 8 samples: the disparity d, the match x_q and its interpolation fraction are
+// computed as float vectors. The texels are 16-bit fixed point (B, G, R, 0, gx, gy, 0, 0), so a
+// sample's two nodes around x_q are one 256-bit load, and two samples (p and p + 4) share each
+// integer operation: interpolation (mulhrs), difference with the own texel, absolute value, and
+// the channel-pair sums; two horizontal adds and a shuffle turn the four pairs into the colour
+// L1 and gradient L1 of the 8 samples, exact integers. From there every float operation is the
+// baseline's, in its order (no FMA contraction, the lanes and their reduction as in
 // cost_kernel.h), so both paths give bit-identical costs and PatchMatch results do not depend on
 // the CPU.
 #include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
@@ -26,25 +27,37 @@ namespace {
 
 constexpr int kMaxOffsets = 101;  // window_radius <= 50 (PatchMatchParams::validate)
 
-/// |own - interpolated| per texel channel of one sample; `t` the left node's texel, f in [0, 1).
-inline __m256 texelDifference(const float* t, const float* f, const float* own, __m256 abs_mask) {
-  const __m256 t0 = _mm256_load_ps(t);  // texels are 32-byte aligned (cost_kernel.h)
-  const __m256 t1 = _mm256_load_ps(t + kTexelFloats);
-  const __m256 m = _mm256_add_ps(t0, _mm256_mul_ps(_mm256_broadcast_ss(f), _mm256_sub_ps(t1, t0)));
-  return _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(own), m));
+/// The 8 samples of a block are handled as the pairs (p, p + 4), p < 4: the lower 128 bits hold
+/// sample p, the upper sample p + 4.
+constexpr int kPairs = kSimdBlock / 2;
+
+/// [v_p | v_{p + 4}] of the 16-byte entries v of a block (texels).
+inline __m256i pairOf(const short* v, int p) {
+  return _mm256_inserti128_si256(
+      _mm256_castsi128_si256(_mm_load_si128(reinterpret_cast<const __m128i*>(v + p * 8))),
+      _mm_load_si128(reinterpret_cast<const __m128i*>(v + (p + kPairs) * 8)), 1);
 }
 
-/// Colour L1 (out: col) and gradient L1 (out: grad) of 8 samples from their per-channel
-/// differences D_k = (dB, dG, dR, 0, dgx, dgy, 0, 0): (dB + dG) + dR and dgx + dgy, as scalar.
-inline void channelSums(const __m256* dk, __m256& col, __m256& grad) {
-  const __m256 h01 = _mm256_hadd_ps(dk[0], dk[1]);
-  const __m256 h23 = _mm256_hadd_ps(dk[2], dk[3]);
-  const __m256 h45 = _mm256_hadd_ps(dk[4], dk[5]);
-  const __m256 h67 = _mm256_hadd_ps(dk[6], dk[7]);
-  const __m256 s0123 = _mm256_hadd_ps(h01, h23);  // colour of 0..3 | gradient of 0..3
-  const __m256 s4567 = _mm256_hadd_ps(h45, h67);
-  col = _mm256_permute2f128_ps(s0123, s4567, 0x20);
-  grad = _mm256_permute2f128_ps(s0123, s4567, 0x31);
+/// Pair p's fractions, each repeated over its 8 channels, from the block's 8 fractions (16-bit)
+/// in both 128-bit halves.
+inline __m256i pairFraction(__m256i fractions, int p) {
+  const char lo = static_cast<char>(2 * p), hi = static_cast<char>(2 * p + 1);
+  const char lo4 = static_cast<char>(2 * p + 8), hi4 = static_cast<char>(2 * p + 9);
+  const __m256i select = _mm256_setr_epi8(lo, hi, lo, hi, lo, hi, lo, hi, lo, hi, lo, hi, lo, hi,
+                                          lo, hi, lo4, hi4, lo4, hi4, lo4, hi4, lo4, hi4, lo4, hi4,
+                                          lo4, hi4, lo4, hi4, lo4, hi4);
+  return _mm256_shuffle_epi8(fractions, select);
+}
+
+/// The colour L1 (out: col) and gradient L1 (out: grad) of the 8 samples, as floats in texel
+/// units, from each pair's |differences| summed by channel pairs (madd with ones):
+/// (B + G, R + 0, gx + gy, 0 + 0) per sample.
+inline void channelSums(const __m256i* pair_sums, __m256& col, __m256& grad) {
+  // Per 128-bit half: (col, grad) of samples 0, 1 | 4, 5 and of 2, 3 | 6, 7.
+  const __m256 a = _mm256_castsi256_ps(_mm256_hadd_epi32(pair_sums[0], pair_sums[1]));
+  const __m256 b = _mm256_castsi256_ps(_mm256_hadd_epi32(pair_sums[2], pair_sums[3]));
+  col = _mm256_cvtepi32_ps(_mm256_castps_si256(_mm256_shuffle_ps(a, b, 0x88)));   // 0..3 | 4..7
+  grad = _mm256_cvtepi32_ps(_mm256_castps_si256(_mm256_shuffle_ps(a, b, 0xDD)));  // the same
 }
 
 /// ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 + l7)) of the 8 lanes (cost_kernel.h's order).
@@ -52,6 +65,61 @@ inline float laneSum(__m256 v) {
   const __m128 s4 = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
   const __m128 s2 = _mm_add_ps(s4, _mm_movehl_ps(s4, s4));
   return _mm_cvtss_f32(_mm_add_ss(s2, _mm_shuffle_ps(s2, s2, 1)));
+}
+
+/// The plane's match of a block of 8 samples: d, the mask of matches inside the image, the left
+/// nodes' offsets in the other view's texels (written to `node`) and the 8 fractions in fixed
+/// point (16-bit, in both 128-bit halves), as cost.cpp's matchOf.
+struct BlockMatch {
+  __m256 d, inside;
+  __m256i fractions;
+};
+
+inline BlockMatch matchBlock(const KernelWindow& w, const KernelConstants& k, int s, __m256 va,
+                             __m256 vb, __m256 vc, int* node) {
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 x = _mm256_loadu_ps(w.xs + s);
+  const __m256 y = _mm256_loadu_ps(w.ys + s);
+  BlockMatch m;
+  m.d = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(va, x), _mm256_mul_ps(vb, y)), vc);
+  const __m256 xm_raw = _mm256_add_ps(x, _mm256_mul_ps(_mm256_set1_ps(k.sign), m.d));
+  m.inside = _mm256_and_ps(_mm256_cmp_ps(xm_raw, zero, _CMP_GE_OQ),
+                           _mm256_cmp_ps(xm_raw, _mm256_set1_ps(k.x_max), _CMP_LE_OQ));
+  const __m256 xm = _mm256_min_ps(_mm256_max_ps(xm_raw, zero), _mm256_set1_ps(k.x_clamp));
+  const __m256i i0 = _mm256_cvttps_epi32(xm);
+  const __m256 f = _mm256_sub_ps(xm, _mm256_cvtepi32_ps(i0));
+  // Rounded to nearest even, saturated at 2^15 - 1 by the pack.
+  const __m256i f32 = _mm256_cvtps_epi32(_mm256_mul_ps(f, _mm256_set1_ps(kFracOne)));
+  m.fractions = _mm256_broadcastsi128_si256(
+      _mm_packs_epi32(_mm256_castsi256_si128(f32), _mm256_extracti128_si256(f32, 1)));
+  const __m256i row = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(w.texel_row + s));
+  _mm256_store_si256(reinterpret_cast<__m256i*>(node),
+                     _mm256_add_epi32(row, _mm256_slli_epi32(i0, 3)));  // 8 shorts per texel
+  return m;
+}
+
+/// Pair p's |own - m| per channel, m interpolated between the nodes, and the nodes' difference
+/// (out: slope) for the sub-pixel step.
+inline __m256i pairDifference(const short* other, const int* node, const short* own, int p,
+                              __m256i fractions, __m256i& slope, __m256i& diff) {
+  const __m256i a = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(other + node[p]));
+  const __m256i b = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(other + node[p + kPairs]));
+  const __m256i t0 = _mm256_permute2x128_si256(a, b, 0x20);
+  slope = _mm256_sub_epi16(_mm256_permute2x128_si256(a, b, 0x31), t0);
+  const __m256i m = _mm256_add_epi16(t0, _mm256_mulhrs_epi16(slope, pairFraction(fractions, p)));
+  diff = _mm256_sub_epi16(pairOf(own, p), m);
+  return _mm256_abs_epi16(diff);
+}
+
+/// The image term of 8 samples: alpha min(col, lambda_col) + beta min(grad, lambda_grad), or the
+/// outside cost where the match left the image.
+inline __m256 imageTerm(const KernelConstants& k, __m256 col, __m256 grad, __m256 inside) {
+  const __m256 rho =
+      _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(k.alpha),
+                                  _mm256_min_ps(col, _mm256_set1_ps(k.lambda_col))),
+                    _mm256_mul_ps(_mm256_set1_ps(k.beta),
+                                  _mm256_min_ps(grad, _mm256_set1_ps(k.lambda_grad))));
+  return _mm256_blendv_ps(_mm256_set1_ps(k.outside_cost), rho, inside);
 }
 
 /// Pass 1 of buildWindowAvx2: positions, texels and priors of the samples inside the image, then
@@ -66,7 +134,7 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
   const int m = j1 - j0;
   // Locals, not s's members: the stores below could alias them as far as the compiler knows.
   const int* const cols = s.offsets + j0;
-  const float* const texels = s.texels;
+  const short* const texels = s.texels;
   const float* const prior = s.prior;
   const float* const trust = s.trust;
   alignas(32) float xcol[kMaxOffsets + kSimdBlock];
@@ -84,10 +152,12 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
       _mm256_storeu_ps(out.ys + k + q, fy);
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.texel_row + k + q), row);
     }
-    const float* texel_row = texels + (static_cast<long>(y) * s.width + px) * kTexelFloats;
-    float* own = out.texels + k * kTexelFloats;
+    const short* texel_row = texels + (static_cast<long>(y) * s.width + px) * kTexelChannels;
+    short* own = out.texels + k * kTexelChannels;
     for (int j = 0; j < m; ++j) {
-      _mm256_store_ps(own + j * kTexelFloats, _mm256_load_ps(texel_row + cols[j] * kTexelFloats));
+      _mm_store_si128(reinterpret_cast<__m128i*>(own + j * kTexelChannels),
+                      _mm_load_si128(reinterpret_cast<const __m128i*>(
+                          texel_row + cols[j] * kTexelChannels)));
     }
     float* priors = out.priors + k;
     float* trusts = out.w_lidar + k;
@@ -107,7 +177,8 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
     out.xs[j] = out.xs[0];
     out.ys[j] = out.ys[0];
     out.texel_row[j] = out.texel_row[0];
-    _mm256_store_ps(out.texels + j * kTexelFloats, _mm256_setzero_ps());
+    _mm_store_si128(reinterpret_cast<__m128i*>(out.texels + j * kTexelChannels),
+                    _mm_setzero_si128());
     out.priors[j] = 0.f;
     out.w_lidar[j] = 0.f;
   }
@@ -122,10 +193,11 @@ int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& 
   const int count = gatherSamples(s, px, py, out, (n + kSimdBlock - 1) / kSimdBlock * kSimdBlock);
   padded = (count + kSimdBlock - 1) / kSimdBlock * kSimdBlock;
   constant = 0.f;
-  const __m256 center =
-      _mm256_loadu_ps(s.texels + (static_cast<long>(py) * s.width + px) * kTexelFloats);
-  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  const __m256 lut_scale = _mm256_set1_ps(s.lut_scale);
+  const __m128i center128 = _mm_load_si128(reinterpret_cast<const __m128i*>(
+      s.texels + (static_cast<long>(py) * s.width + px) * kTexelChannels));
+  const __m256i center = _mm256_broadcastsi128_si256(center128);
+  const __m256i colour = _mm256_setr_epi16(1, 1, 1, 0, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0);
+  const __m256 lut_step = _mm256_set1_ps(s.lut_scale / static_cast<float>(kTexelScale));
   const __m256 lut_last = _mm256_set1_ps(static_cast<float>(s.lut_size - 1));
   const __m256 gamma = _mm256_set1_ps(s.gamma), one = _mm256_set1_ps(1.f);
   const __m256 img_norm = _mm256_set1_ps(s.img_norm), ldisp = _mm256_set1_ps(s.lambda_disp);
@@ -133,26 +205,27 @@ int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& 
   const bool paper_constant = !s.weighted && s.prior != nullptr;
   alignas(32) float empty_cost[kSimdBlock];
   for (int b = 0; b < padded; b += kSimdBlock) {
-    __m256 dk[kSimdBlock];
-    for (int j = 0; j < kSimdBlock; ++j) {
-      dk[j] = _mm256_and_ps(
-          abs_mask, _mm256_sub_ps(_mm256_loadu_ps(out.texels + (b + j) * kTexelFloats), center));
+    // The RGB L1 distance to the centre, in texel units (exact integers).
+    __m256i pair_sums[kPairs];
+    for (int p = 0; p < kPairs; ++p) {
+      const __m256i diff = _mm256_abs_epi16(
+          _mm256_sub_epi16(pairOf(out.texels + b * kTexelChannels, p), center));
+      pair_sums[p] = _mm256_madd_epi16(diff, colour);
     }
     __m256 l1, unused;
-    channelSums(dk, l1, unused);
-    // w = LUT[min(lut_size - 1, int(l1 * lut_scale))] (l1 >= 0), 0 on the padding.
-    const __m256i index =
-        _mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(l1, lut_scale), lut_last));
-    const __m256 valid =
-        _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(count - b), lane));
-    // Eight scalar loads, not a gather instruction: with the microcode mitigation of gather data
-    // sampling on current Intel CPUs a gather costs a fifth of the whole window build.
+    channelSums(pair_sums, l1, unused);
+    // w = LUT[min(lut_size - 1, int(l1 * lut_step))] (l1 >= 0), 0 on the padding. Eight scalar
+    // loads, not a gather instruction: with the microcode mitigation of gather data sampling on
+    // current Intel CPUs a gather costs a fifth of the whole window build.
     alignas(32) int lut_index[kSimdBlock];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(lut_index), index);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(lut_index),
+                       _mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(l1, lut_step), lut_last)));
     const float* lut = s.weight_lut;
     const __m256 looked_up =
         _mm256_setr_ps(lut[lut_index[0]], lut[lut_index[1]], lut[lut_index[2]], lut[lut_index[3]],
                        lut[lut_index[4]], lut[lut_index[5]], lut[lut_index[6]], lut[lut_index[7]]);
+    const __m256 valid =
+        _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(count - b), lane));
     const __m256 w = _mm256_and_ps(valid, looked_up);
     const __m256 trust = _mm256_loadu_ps(out.w_lidar + b);
     if (s.weighted) {  // phi = (1 - kappa) / (alpha + beta) rho_img + kappa rho_lid
@@ -178,41 +251,25 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
                     float bound) {
   if (w.constant >= bound) return w.constant;
   const __m256 va = _mm256_set1_ps(a), vb = _mm256_set1_ps(b), vc = _mm256_set1_ps(c);
-  const __m256 sign = _mm256_set1_ps(k.sign), zero = _mm256_setzero_ps();
-  const __m256 x_max = _mm256_set1_ps(k.x_max), x_clamp = _mm256_set1_ps(k.x_clamp);
-  const __m256 alpha = _mm256_set1_ps(k.alpha), beta = _mm256_set1_ps(k.beta);
-  const __m256 lcol = _mm256_set1_ps(k.lambda_col), lgrad = _mm256_set1_ps(k.lambda_grad);
-  const __m256 ldisp = _mm256_set1_ps(k.lambda_disp), outside = _mm256_set1_ps(k.outside_cost);
+  const __m256 ldisp = _mm256_set1_ps(k.lambda_disp);
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  alignas(32) int offset[kSimdBlock];
-  alignas(32) float frac[kSimdBlock];
-  __m256 acc = zero;  // lane j sums the samples j, j + 8, j + 16, ... (the baseline's lanes)
+  const __m256i ones = _mm256_set1_epi16(1);
+  alignas(32) int node[kSimdBlock];
+  __m256 acc = _mm256_setzero_ps();  // lane j sums the samples j, j + 8, ... (the baseline's)
   for (int s = 0; s < w.count; s += kSimdBlock) {
-    // Each operation as the baseline code does it (no FMA; -ffp-contract=off for this file).
-    const __m256 x = _mm256_loadu_ps(w.xs + s);
-    const __m256 y = _mm256_loadu_ps(w.ys + s);
-    const __m256 d = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(va, x), _mm256_mul_ps(vb, y)), vc);
-    const __m256 xm_raw = _mm256_add_ps(x, _mm256_mul_ps(sign, d));
-    const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(xm_raw, zero, _CMP_GE_OQ),
-                                        _mm256_cmp_ps(xm_raw, x_max, _CMP_LE_OQ));
-    const __m256 xm = _mm256_min_ps(_mm256_max_ps(xm_raw, zero), x_clamp);
-    const __m256i i0 = _mm256_cvttps_epi32(xm);
-    _mm256_store_ps(frac, _mm256_sub_ps(xm, _mm256_cvtepi32_ps(i0)));
-    const __m256i row = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(w.texel_row + s));
-    _mm256_store_si256(reinterpret_cast<__m256i*>(offset),
-                       _mm256_add_epi32(row, _mm256_slli_epi32(i0, 3)));
-    __m256 dk[kSimdBlock];
-    const float* own = w.texels + s * kTexelFloats;
-    for (int j = 0; j < kSimdBlock; ++j) {
-      dk[j] =
-          texelDifference(k.other_texels + offset[j], frac + j, own + j * kTexelFloats, abs_mask);
+    // Each float operation as the baseline code does it (no FMA; -ffp-contract=off here).
+    const BlockMatch m = matchBlock(w, k, s, va, vb, vc, node);
+    const short* own = w.texels + s * kTexelChannels;
+    __m256i pair_sums[kPairs];
+    for (int p = 0; p < kPairs; ++p) {
+      __m256i slope, diff;
+      const __m256i l1 = pairDifference(k.other_texels, node, own, p, m.fractions, slope, diff);
+      pair_sums[p] = _mm256_madd_epi16(l1, ones);
     }
     __m256 col, grad;
-    channelSums(dk, col, grad);
-    __m256 rho_img = _mm256_add_ps(_mm256_mul_ps(alpha, _mm256_min_ps(col, lcol)),
-                                   _mm256_mul_ps(beta, _mm256_min_ps(grad, lgrad)));
-    rho_img = _mm256_blendv_ps(outside, rho_img, inside);
-    const __m256 lid = _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(w.priors + s), d));
+    channelSums(pair_sums, col, grad);
+    const __m256 rho_img = imageTerm(k, col, grad, m.inside);
+    const __m256 lid = _mm256_and_ps(abs_mask, _mm256_sub_ps(_mm256_loadu_ps(w.priors + s), m.d));
     const __m256 rho_lid = _mm256_min_ps(lid, ldisp);
     // Padding samples have zero weights: their term is exactly 0 and leaves the lanes unchanged.
     acc = _mm256_add_ps(acc, _mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(w.w_img + s), rho_img),
@@ -225,64 +282,36 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
 }
 
 void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b,
-                        float c, float h, float& lower, float& upper) {
+                        float c, float h, int shift_q, float& lower, float& upper) {
   const __m256 va = _mm256_set1_ps(a), vb = _mm256_set1_ps(b), vc = _mm256_set1_ps(c);
-  const __m256 sign = _mm256_set1_ps(k.sign), zero = _mm256_setzero_ps();
-  const __m256 vh = _mm256_set1_ps(h), shift = _mm256_set1_ps(k.sign * h);
-  const __m256 x_max = _mm256_set1_ps(k.x_max), x_clamp = _mm256_set1_ps(k.x_clamp);
-  const __m256 alpha = _mm256_set1_ps(k.alpha), beta = _mm256_set1_ps(k.beta);
-  const __m256 lcol = _mm256_set1_ps(k.lambda_col), lgrad = _mm256_set1_ps(k.lambda_grad);
-  const __m256 ldisp = _mm256_set1_ps(k.lambda_disp), outside = _mm256_set1_ps(k.outside_cost);
+  const __m256 vh = _mm256_set1_ps(h), ldisp = _mm256_set1_ps(k.lambda_disp);
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  alignas(32) int offset[kSimdBlock];
-  alignas(32) float frac[kSimdBlock];
-  __m256 acc_lower = zero, acc_upper = zero;
+  const __m256i ones = _mm256_set1_epi16(1), shift = _mm256_set1_epi16(static_cast<short>(shift_q));
+  alignas(32) int node[kSimdBlock];
+  __m256 acc_lower = _mm256_setzero_ps(), acc_upper = _mm256_setzero_ps();
   for (int s = 0; s < w.count; s += kSimdBlock) {
-    // d's match, as aggregateAvx2.
-    const __m256 x = _mm256_loadu_ps(w.xs + s);
-    const __m256 y = _mm256_loadu_ps(w.ys + s);
-    const __m256 d = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(va, x), _mm256_mul_ps(vb, y)), vc);
-    const __m256 xm_raw = _mm256_add_ps(x, _mm256_mul_ps(sign, d));
-    const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(xm_raw, zero, _CMP_GE_OQ),
-                                        _mm256_cmp_ps(xm_raw, x_max, _CMP_LE_OQ));
-    const __m256 xm = _mm256_min_ps(_mm256_max_ps(xm_raw, zero), x_clamp);
-    const __m256i i0 = _mm256_cvttps_epi32(xm);
-    _mm256_store_ps(frac, _mm256_sub_ps(xm, _mm256_cvtepi32_ps(i0)));
-    const __m256i row = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(w.texel_row + s));
-    _mm256_store_si256(reinterpret_cast<__m256i*>(offset),
-                       _mm256_add_epi32(row, _mm256_slli_epi32(i0, 3)));
-    // own - m at d -+ h: own - m +- sign h (t1 - t0), on the interval of d's match.
-    __m256 dk_lower[kSimdBlock], dk_upper[kSimdBlock];
-    const float* own = w.texels + s * kTexelFloats;
-    for (int j = 0; j < kSimdBlock; ++j) {
-      const float* t = k.other_texels + offset[j];
-      const __m256 t0 = _mm256_load_ps(t);
-      const __m256 slope = _mm256_sub_ps(_mm256_load_ps(t + kTexelFloats), t0);
-      const __m256 m = _mm256_add_ps(t0, _mm256_mul_ps(_mm256_broadcast_ss(frac + j), slope));
-      const __m256 diff = _mm256_sub_ps(_mm256_loadu_ps(own + j * kTexelFloats), m);
-      const __m256 moved = _mm256_mul_ps(shift, slope);
-      dk_lower[j] = _mm256_and_ps(abs_mask, _mm256_add_ps(diff, moved));
-      dk_upper[j] = _mm256_and_ps(abs_mask, _mm256_sub_ps(diff, moved));
+    const BlockMatch m = matchBlock(w, k, s, va, vb, vc, node);
+    const short* own = w.texels + s * kTexelChannels;
+    // own - m at d -+ h: own - m +- the nodes' difference times the shift, on d's interval.
+    __m256i sums_lower[kPairs], sums_upper[kPairs];
+    for (int p = 0; p < kPairs; ++p) {
+      __m256i slope, diff;
+      pairDifference(k.other_texels, node, own, p, m.fractions, slope, diff);
+      const __m256i moved = _mm256_mulhrs_epi16(slope, shift);
+      sums_lower[p] = _mm256_madd_epi16(_mm256_abs_epi16(_mm256_add_epi16(diff, moved)), ones);
+      sums_upper[p] = _mm256_madd_epi16(_mm256_abs_epi16(_mm256_sub_epi16(diff, moved)), ones);
     }
     __m256 col_lower, grad_lower, col_upper, grad_upper;
-    channelSums(dk_lower, col_lower, grad_lower);
-    channelSums(dk_upper, col_upper, grad_upper);
-    const __m256 rho_lower = _mm256_blendv_ps(
-        outside,
-        _mm256_add_ps(_mm256_mul_ps(alpha, _mm256_min_ps(col_lower, lcol)),
-                      _mm256_mul_ps(beta, _mm256_min_ps(grad_lower, lgrad))),
-        inside);
-    const __m256 rho_upper = _mm256_blendv_ps(
-        outside,
-        _mm256_add_ps(_mm256_mul_ps(alpha, _mm256_min_ps(col_upper, lcol)),
-                      _mm256_mul_ps(beta, _mm256_min_ps(grad_upper, lgrad))),
-        inside);
+    channelSums(sums_lower, col_lower, grad_lower);
+    channelSums(sums_upper, col_upper, grad_upper);
+    const __m256 rho_lower = imageTerm(k, col_lower, grad_lower, m.inside);
+    const __m256 rho_upper = imageTerm(k, col_upper, grad_upper, m.inside);
     const __m256 prior = _mm256_loadu_ps(w.priors + s);
     const __m256 w_img = _mm256_loadu_ps(w.w_img + s), w_lidar = _mm256_loadu_ps(w.w_lidar + s);
-    const __m256 lid_lower =
-        _mm256_min_ps(_mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_sub_ps(d, vh))), ldisp);
-    const __m256 lid_upper =
-        _mm256_min_ps(_mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_add_ps(d, vh))), ldisp);
+    const __m256 lid_lower = _mm256_min_ps(
+        _mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_sub_ps(m.d, vh))), ldisp);
+    const __m256 lid_upper = _mm256_min_ps(
+        _mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_add_ps(m.d, vh))), ldisp);
     acc_lower = _mm256_add_ps(acc_lower, _mm256_add_ps(_mm256_mul_ps(w_img, rho_lower),
                                                        _mm256_mul_ps(w_lidar, lid_lower)));
     acc_upper = _mm256_add_ps(acc_upper, _mm256_add_ps(_mm256_mul_ps(w_img, rho_upper),
@@ -314,7 +343,7 @@ int buildWindowAvx2(const KernelSelf&, int, int, const KernelWindowOut&, int& pa
 }
 
 void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants&, float, float, float, float,
-                        float& lower, float& upper) {
+                        int, float& lower, float& upper) {
   lower = upper = w.constant;
 }
 

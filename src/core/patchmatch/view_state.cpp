@@ -10,7 +10,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
-#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 
 namespace lidar_stereo_fusion {
 namespace patchmatch {
@@ -63,28 +62,25 @@ void prepareImages(const ViewInput& in, bool use_grad, ViewState& v) {
   cv::merge(std::vector<cv::Mat>{gx, gy}, v.grad);
 }
 
-/// The texels of the AVX2 cost (view_state.h): colour and gradient interleaved, padded to 8.
+/// The texels of the cost (view_state.h, cost_kernel.h): colour and gradient interleaved in
+/// 16-bit fixed point, padded to 8 channels.
 void prepareTexels(ViewState& v) {
-  if (activeSimdPath() != SimdPath::kAvx2) {
-    v.texels.clear();
-    return;
-  }
   // Every entry is written below: the buffer of the previous frame is reused as it is.
   v.texels.resize(static_cast<size_t>(v.width) * v.height);
+  const float scale = static_cast<float>(kTexelScale);
   for (int y = 0; y < v.height; ++y) {
     const cv::Vec3f* crow = v.color.ptr<cv::Vec3f>(y);
     const cv::Vec2f* grow = v.grad.empty() ? nullptr : v.grad.ptr<cv::Vec2f>(y);
     Texel* row = &v.texels[static_cast<size_t>(y) * v.width];
     for (int x = 0; x < v.width; ++x) {
-      float* t = row[x].v;
-      t[0] = crow[x][0];
-      t[1] = crow[x][1];
-      t[2] = crow[x][2];
-      t[3] = 0.f;
-      t[4] = grow != nullptr ? grow[x][0] : 0.f;
-      t[5] = grow != nullptr ? grow[x][1] : 0.f;
-      t[6] = 0.f;
-      t[7] = 0.f;
+      short* t = row[x].v;
+      for (int c = 0; c < 3; ++c) t[c] = static_cast<short>(std::lround(crow[x][c] * scale));
+      t[3] = 0;
+      // |gradient| <= 127.5 (half a grey difference): at most 8160 in fixed point.
+      t[4] = grow != nullptr ? static_cast<short>(std::lround(grow[x][0] * scale)) : 0;
+      t[5] = grow != nullptr ? static_cast<short>(std::lround(grow[x][1] * scale)) : 0;
+      t[6] = 0;
+      t[7] = 0;
     }
   }
 }

@@ -15,6 +15,8 @@
 //    Where the LiDAR is sure (c = 1) this is the paper's phi; where it fades the image term is
 //    renormalised to full weight, so that with no LiDAR it is plain stereo (Bleyer et al.).
 // A sample whose match falls outside the other image costs the colour/gradient truncations.
+// Colours and gradients are read in 16-bit fixed point (cost_kernel.h: colours exactly, gradients
+// and I_q interpolated at q to 1/64), so that the AVX2 kernel handles two samples per operation.
 #pragma once
 
 #include <vector>
@@ -28,18 +30,17 @@ namespace lidar_stereo_fusion {
 namespace patchmatch {
 
 /// The window samples of one pixel in structure-of-arrays form, built once per pixel and shared by
-/// every candidate plane. Arrays are sized once; `count` says how many entries are in use.
-/// The baseline kernel reads c0..g1 and row_offset; the AVX2 kernel reads texels and texel_row,
-/// and `padded` samples: the window padded to a multiple of kSimdBlock with zero-weight samples.
+/// every candidate plane. Arrays are sized once; `count` says how many entries are in use, and
+/// the AVX2 kernel reads `padded` samples: the window padded to a multiple of kSimdBlock with
+/// zero-weight samples.
 struct WindowCache {
   std::vector<float> xs, ys;
   std::vector<float> w_img;    ///< w(p, p') times the image term's factor of phi
   std::vector<float> w_lidar;  ///< w(p, p') times the LiDAR term's factor of phi (0: no prior)
-  std::vector<float> c0, c1, c2, g0, g1, priors;
-  std::vector<int> row_offset;  ///< start of the sample's row in the other view's colour [floats]
-  std::vector<Texel> texels;    ///< the sample's texel (AVX2 path only)
-  std::vector<int> texel_row;   ///< start of the sample's row in the other view's texels [floats]
-  float constant = 0.f;         ///< sum of the plane-independent terms (paper: empty prior)
+  std::vector<float> priors;
+  std::vector<Texel> texels;   ///< the sample's own texel
+  std::vector<int> texel_row;  ///< start of the sample's row in the other view's texels [shorts]
+  float constant = 0.f;        ///< sum of the plane-independent terms (paper: empty prior)
   int count = 0;
   int padded = 0;  ///< count rounded up to a multiple of kSimdBlock (AVX2 path)
   void reserve(size_t n);
@@ -51,7 +52,7 @@ std::vector<int> windowOffsets(int radius, int stride, bool dyadic);
 
 class MatchingCost {
  public:
-  /// Uses the AVX2 kernel when activeSimdPath() is kAvx2 and both views have texels.
+  /// Uses the AVX2 kernel when activeSimdPath() is kAvx2.
   MatchingCost(const PatchMatchParams& params, const ViewState& self, const ViewState& other);
 
   /// w(p, p') for an RGB L1 distance [0, 765].
@@ -78,11 +79,9 @@ class MatchingCost {
   const std::vector<int>& offsets() const { return offsets_; }
 
  private:
-  template <bool kGrad>
   float aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const;
-  template <bool kGrad>
-  void aggregateSidesImpl(const WindowCache& cache, const Plane& plane, float h, float& lower,
-                          float& upper) const;
+  void aggregateSidesImpl(const WindowCache& cache, const Plane& plane, float h, int shift_q,
+                          float& lower, float& upper) const;
 
   static constexpr int kLutSize = 4096;
   static constexpr float kLutScale = 4.f;  ///< LUT entries per unit of RGB L1 distance

@@ -8,15 +8,22 @@
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
-/// Floats per pixel in ViewState::texels and per sample in WindowCache::texels:
-/// B, G, R, 0, gx, gy, 0, 0 (colour 0..255, gradient of the grey image; 0 without gradient).
-constexpr int kTexelFloats = 8;
-
-/// One texel, 32-byte aligned so that the kernel's 8-float loads never straddle a cache line
-/// (std::vector<Texel> allocates with that alignment in C++17).
-struct alignas(32) Texel {
-  float v[kTexelFloats];
+/// Channels per pixel in ViewState::texels and per sample in WindowCache::texels:
+/// B, G, R, 0, gx, gy, 0, 0 (colour 0..255, gradient of the grey image; 0 without gradient),
+/// each in 16-bit fixed point with kTexelScale steps per unit (colour exactly, gradient to
+/// 1/64; the nodes' differences, +- 2 255 64, and a difference moved by the sub-pixel step stay
+/// within 16 bits): one sample's two interpolation nodes fill 256 bits.
+constexpr int kTexelChannels = 8;
+constexpr int kTexelScale = 64;
+/// One texel, 16-byte aligned (std::vector<Texel> allocates with that alignment in C++17).
+struct alignas(16) Texel {
+  short v[kTexelChannels];
 };
+/// The match's texel between nodes t0 and t1 at fraction f in [0, 1), in both kernels:
+/// m = t0 + ((t1 - t0) fq + 2^14) >> 15 per channel with fq = round(f 2^15) (at most 2^15 - 1),
+/// as _mm256_mulhrs_epi16; the L1 sums of |own - m| are exact integers, turned into floats and
+/// divided by kTexelScale through the constants (alpha / 64 times min(L1, 64 lambda_col), ...).
+constexpr int kFracOne = 1 << 15;
 
 /// Samples per SIMD block; WindowCache arrays are padded with zero-weight samples to a multiple.
 constexpr int kSimdBlock = 8;
@@ -28,8 +35,8 @@ struct KernelWindow {
   const float* w_img;    ///< w(p, p') times the image term's factor of phi (0: padding)
   const float* w_lidar;  ///< w(p, p') times the LiDAR term's factor of phi
   const float* priors;   ///< prior disparity [px] (0: none)
-  const float* texels;   ///< the sample's own texel, kTexelFloats per sample
-  const int* texel_row;  ///< start of the sample's row in the other view's texels [floats]
+  const short* texels;   ///< the sample's own texel, kTexelChannels per sample
+  const int* texel_row;  ///< start of the sample's row in the other view's texels [shorts]
   int count;             ///< samples incl. padding, a multiple of kSimdBlock
   int real_count;        ///< samples without the padding
   float constant;        ///< plane-independent part of C
@@ -37,33 +44,36 @@ struct KernelWindow {
 
 /// The other view and the cost's constants (cost.h).
 struct KernelConstants {
-  const float* other_texels;  ///< the other view, kTexelFloats per pixel, row-major
+  const short* other_texels;  ///< the other view, kTexelChannels per pixel, row-major
   float x_max;                ///< width - 1 [px]
   float x_clamp;              ///< largest x of the left interpolation node, < x_max
   float sign;                 ///< match of x at x + sign * d
+  /// alpha and beta divided by kTexelScale, lambda_col and lambda_grad multiplied by it (the
+  /// L1 sums are in texel units); lambda_disp [px]; the image term of a match outside the image.
   float alpha, beta, lambda_col, lambda_grad, lambda_disp, outside_cost;
 };
 
 /// What building a window reads from its own view and the cost's parameters (cost.h).
 struct KernelSelf {
-  const float* texels;         ///< the view's texels, kTexelFloats per pixel, row-major
+  const short* texels;         ///< the view's texels, kTexelChannels per pixel, row-major
   const float* prior;          ///< prior disparity [px] (nullptr: no prior term)
   const float* trust;          ///< the prior's weight [0, 1] (nullptr iff prior is)
   int prior_step, trust_step;  ///< row steps [floats]
   int width, height;
-  int other_texel_stride;  ///< floats per row of the other view's texels
+  int other_texel_stride;  ///< shorts per row of the other view's texels
   const int* offsets;      ///< window offsets in x and y [px]
   int offset_count;
   const float* weight_lut;  ///< w by L1 colour distance times lut_scale
   int lut_size;
-  float lut_scale;
+  float lut_scale;  ///< LUT entries per unit of RGB L1 distance
   bool weighted;  ///< confidence-weighted phi (else the paper's)
   float gamma, img_norm, lambda_disp;
 };
 
 /// Where a window is written: WindowCache's arrays, with room for the padding.
 struct KernelWindowOut {
-  float *xs, *ys, *w_img, *w_lidar, *priors, *texels;
+  float *xs, *ys, *w_img, *w_lidar, *priors;
+  short* texels;
   int* texel_row;
 };
 
@@ -87,9 +97,10 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
 
 /// The costs of the planes d - h and d + h (c -+ h), each sample's match interpolated on the
 /// interval of d's match (linear in the shift, exact where the other view is linear there), in
-/// one pass: MatchingCost::aggregateSides. Summed like C, no bound. Call only with AVX2 + FMA.
+/// one pass: MatchingCost::aggregateSides; shift_q = round(sign h 2^15), the match's move in
+/// the fixed point of the fraction. Summed like C, no bound. Call only with AVX2 + FMA.
 void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b,
-                        float c, float h, float& lower, float& upper);
+                        float c, float h, int shift_q, float& lower, float& upper);
 
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion

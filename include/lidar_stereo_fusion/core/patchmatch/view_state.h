@@ -41,8 +41,8 @@ struct ViewState {
   /// tried when the sweep visits pixel i if `offered[i]`, then withdrawn.
   std::vector<Plane> offer;
   std::vector<uint8_t> offered;
-  /// The colour and gradient as the AVX2 cost reads them: kTexelFloats per pixel, row-major
-  /// (B, G, R, 0, gx, gy, 0, 0). Empty on the baseline path.
+  /// The colour and gradient as the cost reads them (both kernels): kTexelChannels per pixel,
+  /// row-major (B, G, R, 0, gx, gy, 0, 0), 16-bit fixed point (cost_kernel.h).
   std::vector<Texel> texels;
 
   bool bounded(int x, int y) const { return !lo.empty() && hi(y, x) > 0.f; }
