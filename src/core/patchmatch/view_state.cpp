@@ -62,6 +62,9 @@ void prepareImages(const ViewInput& in, bool use_grad, ViewState& v) {
   cv::merge(std::vector<cv::Mat>{gx, gy}, v.grad);
 }
 
+/// v rounded half away from zero (std::lround's rule without its library call).
+short toFixed(float v) { return static_cast<short>(v + (v < 0.f ? -0.5f : 0.5f)); }
+
 /// The texels of the cost (view_state.h, cost_kernel.h): colour and gradient interleaved in
 /// 16-bit fixed point, padded to 8 channels.
 void prepareTexels(ViewState& v) {
@@ -74,11 +77,12 @@ void prepareTexels(ViewState& v) {
     Texel* row = &v.texels[static_cast<size_t>(y) * v.width];
     for (int x = 0; x < v.width; ++x) {
       short* t = row[x].v;
-      for (int c = 0; c < 3; ++c) t[c] = static_cast<short>(std::lround(crow[x][c] * scale));
+      // Colours are whole numbers: exact. |gradient| <= 127.5 (half a grey difference): at most
+      // 8160 in fixed point, rounded half away from zero.
+      for (int c = 0; c < 3; ++c) t[c] = static_cast<short>(crow[x][c] * scale);
       t[3] = 0;
-      // |gradient| <= 127.5 (half a grey difference): at most 8160 in fixed point.
-      t[4] = grow != nullptr ? static_cast<short>(std::lround(grow[x][0] * scale)) : 0;
-      t[5] = grow != nullptr ? static_cast<short>(std::lround(grow[x][1] * scale)) : 0;
+      t[4] = grow != nullptr ? toFixed(grow[x][0] * scale) : 0;
+      t[5] = grow != nullptr ? toFixed(grow[x][1] * scale) : 0;
       t[6] = 0;
       t[7] = 0;
     }
