@@ -153,23 +153,25 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.texel_row + k + q), row);
     }
     const short* texel_row = texels + (static_cast<long>(y) * s.width + px) * kTexelChannels;
-    short* own = out.texels + k * kTexelChannels;
-    for (int j = 0; j < m; ++j) {
-      _mm_store_si128(reinterpret_cast<__m128i*>(own + j * kTexelChannels),
-                      _mm_load_si128(reinterpret_cast<const __m128i*>(
-                          texel_row + cols[j] * kTexelChannels)));
-    }
+    __m128i* own = reinterpret_cast<__m128i*>(out.texels + k * kTexelChannels);
     float* priors = out.priors + k;
     float* trusts = out.w_lidar + k;
-    if (prior != nullptr) {
+    if (prior != nullptr) {  // one pass over the columns for texel, prior and trust
       const float* prior_row = prior + static_cast<long>(y) * s.prior_step + px;
       const float* trust_row = trust + static_cast<long>(y) * s.trust_step + px;
       for (int j = 0; j < m; ++j) {
-        priors[j] = prior_row[cols[j]];
-        trusts[j] = trust_row[cols[j]];
+        const int col = cols[j];
+        _mm_store_si128(own + j, _mm_load_si128(reinterpret_cast<const __m128i*>(
+                                     texel_row + col * kTexelChannels)));
+        priors[j] = prior_row[col];
+        trusts[j] = trust_row[col];
       }
     } else {
-      for (int j = 0; j < m; ++j) priors[j] = trusts[j] = 0.f;
+      for (int j = 0; j < m; ++j) {
+        _mm_store_si128(own + j, _mm_load_si128(reinterpret_cast<const __m128i*>(
+                                     texel_row + cols[j] * kTexelChannels)));
+        priors[j] = trusts[j] = 0.f;
+      }
     }
     k += m;
   }
