@@ -208,9 +208,9 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
   const short* other = other_.texels.data()->v;
   const KernelConstants& kc = kernel_;
   // Terms are summed in kSimdBlock lanes (sample k into lane k % 8), the lanes reduced by
-  // laneSum(), and the bound checked after every block of 8 samples: the AVX2 kernel's order, so
-  // both return the same float. Most refinement candidates are worse than the current plane and
-  // exceed it after a few blocks.
+  // laneSum(), and the bound checked after every second block of 8 samples: the AVX2 kernel's
+  // order, so both return the same float. Most refinement candidates are worse than the current
+  // plane and exceed it after a few blocks.
   float lanes[kSimdBlock] = {};
   for (int start = 0; start < cache.count; start += kSimdBlock) {
     const int end = std::min(cache.count, start + kSimdBlock);
@@ -232,8 +232,10 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
       const float rho_lid = std::min(std::abs(cache.priors[k] - d), kc.lambda_disp);
       lanes[k - start] += cache.w_img[k] * rho_img + cache.w_lidar[k] * rho_lid;
     }
-    const float sum = cache.constant + laneSum(lanes);
-    if (sum >= bound) return sum;
+    if ((start / kSimdBlock) % 2 == 1) {
+      const float sum = cache.constant + laneSum(lanes);
+      if (sum >= bound) return sum;
+    }
   }
   return cache.constant + laneSum(lanes);
 }

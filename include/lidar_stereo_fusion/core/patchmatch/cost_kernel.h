@@ -88,8 +88,9 @@ extern const bool kAvx2KernelBuilt;
 
 /// Summation order of C, shared by both paths so that they return the same float: sample k's
 /// term is added to lane k % kSimdBlock; C = constant + ((l0 + l4) + (l2 + l6)) + ((l1 + l5) +
-/// (l3 + l7)); the bound is checked after every block of kSimdBlock samples (a partial sum only
-/// grows, so checking never changes which plane wins).
+/// (l3 + l7)); the bound is checked after every second block of kSimdBlock samples (a partial
+/// sum only grows, so checking never changes which plane wins; every block, the check would cost
+/// more than the blocks it saves).
 /// C(p, xi) for the plane d = a x + b y + c over the window; stops once the partial sum is
 /// >= bound (returning it), else returns the full sum. Call only when the CPU has AVX2 + FMA.
 float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b, float c,
