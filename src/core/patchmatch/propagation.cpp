@@ -255,9 +255,13 @@ void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, i
   const int strips = (v.height + kStripRows - 1) / kStripRows;
   for (int phase = 0; phase < 2; ++phase) {
     const int parity = forward ? phase : 1 - phase;
+    // This phase's strips: every second one from `parity` on, counted from the sweep's start
+    // (the bottom for a backward sweep). They are independent, so they are handed out top first
+    // in either direction: above the LiDAR, where no pixel is locked, strips take longest.
+    const int last = forward ? strips - 1 : strips - 1 - parity;
+    const int first = forward ? parity : ((strips - 1 - parity) % 2 + 2) % 2;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int s = parity; s < strips; s += 2) {
-      const int strip = forward ? s : strips - 1 - s;
+    for (int strip = first; strip <= last; strip += 2) {
       const int y0 = strip * kStripRows;
       const int y1 = std::min(v.height, y0 + kStripRows);
       WindowCache cache;
