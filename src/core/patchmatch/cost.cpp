@@ -181,6 +181,9 @@ namespace {
 /// _mm256_mulhrs_epi16 of one lane: round(a b / 2^15).
 inline int mulhrs(int a, int b) { return (a * b + (1 << 14)) >> 15; }
 
+/// The texel channels that carry a value: B, G, R, gx, gy.
+constexpr int kUsedChannels[] = {0, 1, 2, 4, 5};
+
 /// Where sample k's plane disparity d matches in the other view, as both kernels compute it:
 /// `inside` the image, the left node's offset in the other view's texels [shorts] and the
 /// fraction in fixed point.
@@ -220,8 +223,8 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
       // The match's texel by linear interpolation (sub-pixel match), in fixed point.
       const short* t0 = other + m.node;
       const short* own = cache.texels[k].v;
-      int l1[kTexelChannels];
-      for (int c = 0; c < kTexelChannels; ++c) {
+      int l1[kTexelChannels] = {};  // channels 3, 6 and 7 are 0 in every texel
+      for (const int c : kUsedChannels) {
         l1[c] = std::abs(own[c] - (t0[c] + mulhrs(t0[kTexelChannels + c] - t0[c], m.frac_q)));
       }
       const float col = static_cast<float>((l1[0] + l1[1]) + l1[2]);
@@ -253,8 +256,8 @@ void MatchingCost::aggregateSidesImpl(const WindowCache& cache, const Plane& pla
     const Match m = matchOf(cache.xs[k], d, kc.sign, x_max, kc.x_clamp, cache.texel_row[k]);
     const short* t0 = other + m.node;
     const short* own = cache.texels[k].v;
-    int l1_lower[kTexelChannels], l1_upper[kTexelChannels];
-    for (int c = 0; c < kTexelChannels; ++c) {
+    int l1_lower[kTexelChannels] = {}, l1_upper[kTexelChannels] = {};
+    for (const int c : kUsedChannels) {
       const int slope = t0[kTexelChannels + c] - t0[c];
       const int diff = own[c] - (t0[c] + mulhrs(slope, m.frac_q));
       const int moved = mulhrs(slope, shift_q);
