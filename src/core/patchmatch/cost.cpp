@@ -16,6 +16,14 @@ float laneSum(const float* l) {
   return ((l[0] + l[4]) + (l[2] + l[6])) + ((l[1] + l[5]) + (l[3] + l[7]));
 }
 
+/// The window as the AVX2 kernels read it.
+KernelWindow kernelWindow(const WindowCache& cache) {
+  return KernelWindow{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
+                      cache.w_lidar.data(),   cache.priors.data(), cache.texels.data()->v,
+                      cache.texel_row.data(), cache.padded,        cache.count,
+                      cache.constant};
+}
+
 }  // namespace
 
 std::vector<int> windowOffsets(int radius, int stride, bool dyadic) {
@@ -111,8 +119,7 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
   int k = 0;
   const short* texels = self_.texels.data()->v;
   const short* center = texels + (static_cast<long>(py) * self_.width + px) * kTexelChannels;
-  const float lut_step = kLutScale / static_cast<float>(kTexelScale);  // per texel unit of L1
-  const float lut_last = static_cast<float>(kLutSize - 1);
+  const float texel_unit = 1.f / static_cast<float>(kTexelScale);  // exact: a power of two
   for (int dy : offsets_) {
     const int y = py + dy;
     if (y < 0 || y >= self_.height) continue;
@@ -124,8 +131,7 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
       const Texel& t = self_.texels[static_cast<size_t>(y) * self_.width + x];
       const int l1 = std::abs(t.v[0] - center[0]) + std::abs(t.v[1] - center[1]) +
                      std::abs(t.v[2] - center[2]);
-      const float w = weight_lut_[static_cast<int>(std::min(static_cast<float>(l1) * lut_step,
-                                                            lut_last))];
+      const float w = supportWeight(static_cast<float>(l1) * texel_unit);
       cache.xs[k] = static_cast<float>(x);
       cache.ys[k] = static_cast<float>(y);
       cache.texels[k] = t;
@@ -151,13 +157,7 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
 }
 
 float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, float bound) const {
-  if (avx2_) {
-    const KernelWindow w{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
-                         cache.w_lidar.data(),   cache.priors.data(), cache.texels.data()->v,
-                         cache.texel_row.data(), cache.padded,        cache.count,
-                         cache.constant};
-    return aggregateAvx2(w, kernel_, plane.a, plane.b, plane.c, bound);
-  }
+  if (avx2_) return aggregateAvx2(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, bound);
   return aggregateImpl(cache, plane, bound);
 }
 
@@ -166,11 +166,8 @@ void MatchingCost::aggregateSides(const WindowCache& cache, const Plane& plane, 
   // The match's move by sign h in the fixed point of the interpolation fraction.
   const int shift_q = static_cast<int>(std::lround(self_.match_sign * h * kFracOne));
   if (avx2_) {
-    const KernelWindow w{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
-                         cache.w_lidar.data(),   cache.priors.data(), cache.texels.data()->v,
-                         cache.texel_row.data(), cache.padded,        cache.count,
-                         cache.constant};
-    aggregateSidesAvx2(w, kernel_, plane.a, plane.b, plane.c, h, shift_q, lower, upper);
+    aggregateSidesAvx2(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, h, shift_q, lower,
+                       upper);
     return;
   }
   aggregateSidesImpl(cache, plane, h, shift_q, lower, upper);
@@ -183,6 +180,15 @@ inline int mulhrs(int a, int b) { return (a * b + (1 << 14)) >> 15; }
 
 /// The texel channels that carry a value: B, G, R, gx, gy.
 constexpr int kUsedChannels[] = {0, 1, 2, 4, 5};
+
+/// The image term of one sample from its per-channel |own - m| in texel units (cost_kernel.h's
+/// constants), or the outside cost where the match left the image: the AVX2 kernels' imageTerm.
+inline float imageTerm(const KernelConstants& kc, const int* l1, bool inside) {
+  if (!inside) return kc.outside_cost;
+  const float col = static_cast<float>((l1[0] + l1[1]) + l1[2]);
+  const float grad = static_cast<float>(l1[4] + l1[5]);
+  return kc.alpha * std::min(col, kc.lambda_col) + kc.beta * std::min(grad, kc.lambda_grad);
+}
 
 /// Where sample k's plane disparity d matches in the other view, as both kernels compute it:
 /// `inside` the image, the left node's offset in the other view's texels [shorts] and the
@@ -227,11 +233,7 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
       for (const int c : kUsedChannels) {
         l1[c] = std::abs(own[c] - (t0[c] + mulhrs(t0[kTexelChannels + c] - t0[c], m.frac_q)));
       }
-      const float col = static_cast<float>((l1[0] + l1[1]) + l1[2]);
-      const float grad = static_cast<float>(l1[4] + l1[5]);
-      float rho_img = kc.alpha * std::min(col, kc.lambda_col) +
-                      kc.beta * std::min(grad, kc.lambda_grad);
-      if (!m.inside) rho_img = kc.outside_cost;
+      const float rho_img = imageTerm(kc, l1, m.inside);
       const float rho_lid = std::min(std::abs(cache.priors[k] - d), kc.lambda_disp);
       lanes[k - start] += cache.w_img[k] * rho_img + cache.w_lidar[k] * rho_lid;
     }
@@ -268,12 +270,7 @@ void MatchingCost::aggregateSidesImpl(const WindowCache& cache, const Plane& pla
     const float dh[2] = {d - h, d + h};
     float* lanes[2] = {lanes_lower, lanes_upper};
     for (int side = 0; side < 2; ++side) {
-      const int* l1 = l1s[side];
-      const float col = static_cast<float>((l1[0] + l1[1]) + l1[2]);
-      const float grad = static_cast<float>(l1[4] + l1[5]);
-      float rho_img = kc.alpha * std::min(col, kc.lambda_col) +
-                      kc.beta * std::min(grad, kc.lambda_grad);
-      if (!m.inside) rho_img = kc.outside_cost;
+      const float rho_img = imageTerm(kc, l1s[side], m.inside);
       const float rho_lid = std::min(std::abs(cache.priors[k] - dh[side]), kc.lambda_disp);
       lanes[side][k % kSimdBlock] += cache.w_img[k] * rho_img + cache.w_lidar[k] * rho_lid;
     }

@@ -210,8 +210,9 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   if (p.lr_check) {
     const std::vector<uint8_t> keep = lockedToPrior(lv);
     if (inconsistent.empty()) {
-      inconsistent = leftRightCheck(result.disparity, result.right_disparity,
-                                    static_cast<float>(p.lr_max_diff), keep, unmatched_bad, threads);
+      const float max_diff = static_cast<float>(p.lr_max_diff);
+      inconsistent = leftRightCheck(result.disparity, result.right_disparity, max_diff, keep,
+                                    unmatched_bad, threads);
     } else {
       for (size_t i = 0; i < keep.size(); ++i) {
         if (keep[i]) inconsistent.data[i] = 0;  // the LiDAR measured it (leftRightCheck's keep)

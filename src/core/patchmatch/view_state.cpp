@@ -41,7 +41,10 @@ void imageRange(const ViewInput& in, const PatchMatchParams& p, float& d_min, fl
   if (d_max <= d_min) d_max = d_min + 2.f * margin + 1e-3f;
 }
 
-void prepareImages(const ViewInput& in, bool use_grad, ViewState& v) {
+/// The view's colour (v.color) and, if use_grad, the gradients of its grey image (central
+/// differences, (I(x+1) - I(x-1)) / 2; else left empty), which only the texels keep.
+void prepareImages(const ViewInput& in, bool use_grad, ViewState& v, cv::Mat1f& gx,
+                   cv::Mat1f& gy) {
   cv::Mat bgr;
   if (in.image.channels() == 1) {
     cv::cvtColor(in.image, bgr, cv::COLOR_GRAY2BGR);
@@ -49,31 +52,27 @@ void prepareImages(const ViewInput& in, bool use_grad, ViewState& v) {
     bgr = in.image;
   }
   bgr.convertTo(v.color, CV_32FC3);
-  if (!use_grad) {
-    v.grad.release();
-    return;
-  }
-  cv::Mat grey, gx, gy;
+  if (!use_grad) return;
+  cv::Mat grey;
   cv::cvtColor(v.color, grey, cv::COLOR_BGR2GRAY);
-  // Central differences: (I(x+1) - I(x-1)) / 2.
   const cv::Mat kx = (cv::Mat_<float>(1, 3) << -0.5f, 0.f, 0.5f);
   cv::filter2D(grey, gx, CV_32F, kx, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
   cv::filter2D(grey, gy, CV_32F, kx.t(), cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
-  cv::merge(std::vector<cv::Mat>{gx, gy}, v.grad);
 }
 
 /// v rounded half away from zero (std::lround's rule without its library call).
 short toFixed(float v) { return static_cast<short>(v + (v < 0.f ? -0.5f : 0.5f)); }
 
-/// The texels of the cost (view_state.h, cost_kernel.h): colour and gradient interleaved in
-/// 16-bit fixed point, padded to 8 channels.
-void prepareTexels(ViewState& v) {
+/// The texels of the cost (view_state.h, cost_kernel.h): colour and gradient (gx, gy; 0 where
+/// empty) interleaved in 16-bit fixed point, padded to 8 channels.
+void prepareTexels(const cv::Mat1f& gx, const cv::Mat1f& gy, ViewState& v) {
   // Every entry is written below: the buffer of the previous frame is reused as it is.
   v.texels.resize(static_cast<size_t>(v.width) * v.height);
   const float scale = static_cast<float>(kTexelScale);
   for (int y = 0; y < v.height; ++y) {
     const cv::Vec3f* crow = v.color.ptr<cv::Vec3f>(y);
-    const cv::Vec2f* grow = v.grad.empty() ? nullptr : v.grad.ptr<cv::Vec2f>(y);
+    const float* gxrow = gx.empty() ? nullptr : gx[y];
+    const float* gyrow = gy.empty() ? nullptr : gy[y];
     Texel* row = &v.texels[static_cast<size_t>(y) * v.width];
     for (int x = 0; x < v.width; ++x) {
       short* t = row[x].v;
@@ -81,8 +80,8 @@ void prepareTexels(ViewState& v) {
       // 8160 in fixed point, rounded half away from zero.
       for (int c = 0; c < 3; ++c) t[c] = static_cast<short>(crow[x][c] * scale);
       t[3] = 0;
-      t[4] = grow != nullptr ? toFixed(grow[x][0] * scale) : 0;
-      t[5] = grow != nullptr ? toFixed(grow[x][1] * scale) : 0;
+      t[4] = gxrow != nullptr ? toFixed(gxrow[x] * scale) : 0;
+      t[5] = gyrow != nullptr ? toFixed(gyrow[x] * scale) : 0;
       t[6] = 0;
       t[7] = 0;
     }
@@ -152,8 +151,9 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
   v.width = in.image.cols;
   v.height = in.image.rows;
   v.match_sign = match_sign;
-  prepareImages(in, p.beta > 0, v);
-  prepareTexels(v);
+  cv::Mat1f gx, gy;
+  prepareImages(in, p.beta > 0, v, gx, gy);
+  prepareTexels(gx, gy, v);
   v.prior = in.prior;
   prepareTrust(in, p, v);
   v.lo = in.bounds.lo;
