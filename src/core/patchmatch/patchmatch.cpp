@@ -37,6 +37,21 @@ std::vector<uint8_t> lockedToPrior(const patchmatch::ViewState& v) {
   return keep;
 }
 
+/// Runs the two views' independent steps, the right one beside the left with more than one
+/// thread (its exceptions reach here through the future, whose destructor waits if the left
+/// throws).
+template <class Left, class Right>
+void bothViews(int threads, Left&& left, Right&& right) {
+  std::future<void> right_done;
+  if (threads > 1) {
+    right_done = std::async(std::launch::async, right);
+  } else {
+    right();
+  }
+  left();
+  if (right_done.valid()) right_done.get();
+}
+
 cv::Mat3f planeMap(const patchmatch::ViewState& v, int threads) {
   cv::Mat3f map(v.height, v.width);
 #pragma omp parallel for schedule(static) num_threads(threads)
@@ -104,22 +119,12 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   if (!scratch_) scratch_ = std::make_shared<Scratch>();
   ViewState& lv = scratch_->left;
   ViewState& rv = scratch_->right;
-  {
-    // The views are independent: the right one is prepared beside the left (its exceptions
-    // reach here through the future, whose destructor waits if the left throws).
-    std::future<void> right_ready;
-    if (threadCount(p) > 1) {
-      right_ready = std::async(std::launch::async, [&] { prepareView(right, p, +1.f, rv); });
-    } else {
-      prepareView(right, p, +1.f, rv);
-    }
-    prepareView(left, p, -1.f, lv);
-    if (right_ready.valid()) right_ready.get();
-  }
+  const int threads = threadCount(p);
+  bothViews(threads, [&] { prepareView(left, p, -1.f, lv); },
+            [&] { prepareView(right, p, +1.f, rv); });
   const bool two_views = p.view_propagation || p.lr_check;
 
   int iterations = p.iterations;
-  const int threads = threadCount(p);
   const bool unmatched_bad = p.confidence_weighting && !lv.prior.empty();
   const bool guided = p.coarse_scale > 1 && std::min(size.width, size.height) >= 4 * p.coarse_scale;
   // Whether the full-size right view is searched: without a coarse start always; after one for
@@ -131,17 +136,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
     if (!coarse_) coarse_ = std::make_shared<PatchMatchStereo>(coarseParams(p));
     coarse_->setParams(coarseParams(p));
     ViewInput coarse_left, coarse_right;
-    {
-      std::future<void> right_ready;  // the two views reduced side by side, as prepared
-      if (threads > 1) {
-        right_ready = std::async(std::launch::async,
-                                 [&] { coarse_right = downsampleView(right, p.coarse_scale); });
-      } else {
-        coarse_right = downsampleView(right, p.coarse_scale);
-      }
-      coarse_left = downsampleView(left, p.coarse_scale);
-      if (right_ready.valid()) right_ready.get();
-    }
+    bothViews(threads, [&] { coarse_left = downsampleView(left, p.coarse_scale); },
+              [&] { coarse_right = downsampleView(right, p.coarse_scale); });
     const PatchMatchResult coarse = coarse_->compute(coarse_left, coarse_right);
     setGuide(upsamplePlanes(coarse.planes, p.coarse_scale, size, threads), p, lv);
     // The coarse level has no left-right check, so without view propagation it has no right view.
