@@ -31,6 +31,29 @@ constexpr int kMaxOffsets = 101;  // window_radius <= 50 (PatchMatchParams::vali
 /// sample p, the upper sample p + 4.
 constexpr int kPairs = kSimdBlock / 2;
 
+/// Calls f(PairIndex<p>()) for the pairs p < pairs that hold a real sample (p < kPairs; the
+/// shuffles that pick a pair's lanes take p as an immediate) and sets sums[p] to zero for the
+/// others. Only a window's last block has pairs of padding alone; their zero-weight terms are 0
+/// either way, so skipping them changes no float (a 7 x 7 window's last block holds 1 sample).
+template <int p>
+struct PairIndex {
+  static constexpr int value = p;
+};
+template <class F>
+inline void forRealPairs(int pairs, __m256i* sums, F&& f) {
+  f(PairIndex<0>());  // a block holds at least one real sample
+  if (pairs > 1) f(PairIndex<1>()); else sums[1] = _mm256_setzero_si256();
+  if (pairs > 2) f(PairIndex<2>()); else sums[2] = _mm256_setzero_si256();
+  if (pairs > 3) f(PairIndex<3>()); else sums[3] = _mm256_setzero_si256();
+}
+
+/// The pairs of the block starting at sample s that hold a real sample (pair p holds p and
+/// p + kPairs).
+inline int realPairs(int real_count, int s) {
+  const int left = real_count - s;
+  return left < kPairs ? left : kPairs;
+}
+
 /// [v_p | v_{p + 4}] of the 16-byte entries v of a block (texels).
 inline __m256i pairOf(const short* v, int p) {
   return _mm256_inserti128_si256(
@@ -209,11 +232,12 @@ int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& 
   for (int b = 0; b < padded; b += kSimdBlock) {
     // The RGB L1 distance to the centre, in texel units (exact integers).
     __m256i pair_sums[kPairs];
-    for (int p = 0; p < kPairs; ++p) {
+    forRealPairs(realPairs(count, b), pair_sums, [&](auto pair) {
+      constexpr int p = decltype(pair)::value;
       const __m256i diff = _mm256_abs_epi16(
           _mm256_sub_epi16(pairOf(out.texels + b * kTexelChannels, p), center));
       pair_sums[p] = _mm256_madd_epi16(diff, colour);
-    }
+    });
     __m256 l1, unused;
     channelSums(pair_sums, l1, unused);
     // w = LUT[min(lut_size - 1, int(l1 * lut_step))] (l1 >= 0), 0 on the padding. Eight scalar
@@ -263,11 +287,12 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
     const BlockMatch m = matchBlock(w, k, s, va, vb, vc, node);
     const short* own = w.texels + s * kTexelChannels;
     __m256i pair_sums[kPairs];
-    for (int p = 0; p < kPairs; ++p) {
+    forRealPairs(realPairs(w.real_count, s), pair_sums, [&](auto pair) {
+      constexpr int p = decltype(pair)::value;
       __m256i slope, diff;
       const __m256i l1 = pairDifference(k.other_texels, node, own, p, m.fractions, slope, diff);
       pair_sums[p] = _mm256_madd_epi16(l1, ones);
-    }
+    });
     __m256 col, grad;
     channelSums(pair_sums, col, grad);
     const __m256 rho_img = imageTerm(k, col, grad, m.inside);
@@ -299,13 +324,16 @@ void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a
     const short* own = w.texels + s * kTexelChannels;
     // own - m at d -+ h: own - m +- the nodes' difference times the shift, on d's interval.
     __m256i sums_lower[kPairs], sums_upper[kPairs];
-    for (int p = 0; p < kPairs; ++p) {
+    const int pairs = realPairs(w.real_count, s);
+    forRealPairs(pairs, sums_lower, [&](auto pair) {
+      constexpr int p = decltype(pair)::value;
       __m256i slope, diff;
       pairDifference(k.other_texels, node, own, p, m.fractions, slope, diff);
       const __m256i moved = _mm256_mulhrs_epi16(slope, shift);
       sums_lower[p] = _mm256_madd_epi16(_mm256_abs_epi16(_mm256_add_epi16(diff, moved)), ones);
       sums_upper[p] = _mm256_madd_epi16(_mm256_abs_epi16(_mm256_sub_epi16(diff, moved)), ones);
-    }
+    });
+    for (int p = pairs; p < kPairs; ++p) sums_upper[p] = _mm256_setzero_si256();
     __m256 col_lower, grad_lower, col_upper, grad_upper;
     channelSums(sums_lower, col_lower, grad_lower);
     channelSums(sums_upper, col_upper, grad_upper);
