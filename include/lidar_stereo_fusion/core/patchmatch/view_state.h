@@ -44,7 +44,10 @@ struct ViewState {
   /// row-major (B, G, R, 0, gx, gy, 0, 0), 16-bit fixed point (cost_kernel.h).
   std::vector<Texel> texels;
 
-  bool bounded(int x, int y) const { return !lo.empty() && hi(y, x) > 0.f; }
+  /// Whether (x, y) has scan-line bounds. Asked for every candidate plane: it tests the data
+  /// pointer, as cv::Mat::empty() is a call into the library (lo is empty or full-size,
+  /// checkViewInput).
+  bool bounded(int x, int y) const { return lo.data != nullptr && hi(y, x) > 0.f; }
   bool isLocked(int idx) const { return locked[idx] != 0; }
 };
 
