@@ -42,9 +42,21 @@ struct PairIndex {
 template <class F>
 inline void forRealPairs(int pairs, __m256i* sums, F&& f) {
   f(PairIndex<0>());  // a block holds at least one real sample
-  if (pairs > 1) f(PairIndex<1>()); else sums[1] = _mm256_setzero_si256();
-  if (pairs > 2) f(PairIndex<2>()); else sums[2] = _mm256_setzero_si256();
-  if (pairs > 3) f(PairIndex<3>()); else sums[3] = _mm256_setzero_si256();
+  if (pairs > 1) {
+    f(PairIndex<1>());
+  } else {
+    sums[1] = _mm256_setzero_si256();
+  }
+  if (pairs > 2) {
+    f(PairIndex<2>());
+  } else {
+    sums[2] = _mm256_setzero_si256();
+  }
+  if (pairs > 3) {
+    f(PairIndex<3>());
+  } else {
+    sums[3] = _mm256_setzero_si256();
+  }
 }
 
 /// The pairs of the block starting at sample s that hold a real sample (pair p holds p and
