@@ -4,8 +4,12 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <thread>
+#include <vector>
 
 namespace lidar_stereo_fusion {
 namespace patchmatch {
@@ -253,18 +257,39 @@ void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, i
   const int threads = threadCount(p);
   // The strip layout must not depend on the thread count, or results would.
   const int strips = (v.height + kStripRows - 1) / kStripRows;
+  // Two phases: forward, the even strips, then the odd ones; backward, counted from the bottom
+  // strip, the odd ones first. Within a phase strips are independent, and they are handed out
+  // top first in either direction: above the LiDAR, where no pixel is locked, strips take
+  // longest.
+  const int first_parity = forward ? 0 : strips % 2;
+  std::vector<int> order;
+  order.reserve(strips);
   for (int phase = 0; phase < 2; ++phase) {
-    const int parity = forward ? phase : 1 - phase;
-    // This phase's strips: every second one from `parity` on, counted from the sweep's start
-    // (the bottom for a backward sweep). They are independent, so they are handed out top first
-    // in either direction: above the LiDAR, where no pixel is locked, strips take longest.
-    const int last = forward ? strips - 1 : strips - 1 - parity;
-    const int first = forward ? parity : ((strips - 1 - parity) % 2 + 2) % 2;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int strip = first; strip <= last; strip += 2) {
+    for (int strip = 0; strip < strips; ++strip) {
+      if ((strip % 2 == first_parity) == (phase == 0)) order.push_back(strip);
+    }
+  }
+  // No barrier between the phases: a second-phase strip starts once its two neighbours are done
+  // (it reads their rows next to it, and they read its rows as the phase before left them). The
+  // data each strip sees is the two-phase order's, so results are the same for any thread count
+  // and schedule; a thread taking a second-phase strip waits only for strips already taken,
+  // which never wait themselves.
+  std::unique_ptr<std::atomic<bool>[]> done(new std::atomic<bool>[strips]);
+  for (int i = 0; i < strips; ++i) done[i].store(false, std::memory_order_relaxed);
+  std::atomic<int> next{0};
+  const auto ready = [&](int strip) {
+    return strip < 0 || strip >= strips || done[strip].load(std::memory_order_acquire);
+  };
+#pragma omp parallel num_threads(threads)
+  {
+    WindowCache cache;
+    for (int i = next.fetch_add(1); i < strips; i = next.fetch_add(1)) {
+      const int strip = order[i];
+      if (strip % 2 != first_parity) {
+        while (!ready(strip - 1) || !ready(strip + 1)) std::this_thread::yield();
+      }
       const int y0 = strip * kStripRows;
       const int y1 = std::min(v.height, y0 + kStripRows);
-      WindowCache cache;
       if (forward) {
         for (int y = y0; y < y1; ++y)
           for (int x = 0; x < v.width; ++x) search.processPixel(x, y, true, iteration, cache);
@@ -272,6 +297,7 @@ void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, i
         for (int y = y1 - 1; y >= y0; --y)
           for (int x = v.width - 1; x >= 0; --x) search.processPixel(x, y, false, iteration, cache);
       }
+      done[strip].store(true, std::memory_order_release);
     }
   }
 }

@@ -17,10 +17,11 @@
 //  * Locked pixels (prior confidence >= lock_confidence) keep the prior's plane: they are not
 //    searched and receive no view propagation, but offer their plane to their neighbours.
 //  * Parallelism: the image is cut into horizontal strips of kStripRows rows processed in two
-//    phases (even strips in parallel, then odd strips), each strip swept in the paper's order.
-//    Adjacent strips are never written at the same time, so the sweep is race-free; random
-//    numbers come from a counter-based generator keyed by (seed, view, iteration, pixel), so the
-//    result does not depend on the number of threads.
+//    phases (every second strip in parallel, then the others), each strip swept in the paper's
+//    order. A second-phase strip starts as soon as its two neighbours are done, without waiting
+//    for the whole first phase. Adjacent strips are never written at the same time, so the sweep
+//    is race-free; random numbers come from a counter-based generator keyed by (seed, view,
+//    iteration, pixel), so the result does not depend on the number of threads.
 #pragma once
 
 #include "lidar_stereo_fusion/core/patchmatch.h"
@@ -117,7 +118,8 @@ constexpr float kUnknownCost = -1.f;
 /// Initial planes of a view (view 0 = left, 1 = right); their costs are left kUnknownCost.
 void initialise(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int view);
 
-/// One sweep of spatial propagation + refinement over a view (strips in two phases).
+/// One sweep of spatial propagation + refinement over a view (strips in two phases, a
+/// second-phase strip starting once its neighbours are done).
 void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int iteration);
 
 /// View propagation: every pixel of `src` offers its plane, transferred into the other view, to
