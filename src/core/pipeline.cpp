@@ -2,8 +2,9 @@
 #include "lidar_stereo_fusion/core/pipeline.h"
 
 #include <chrono>
-#include <future>
 #include <stdexcept>
+
+#include "lidar_stereo_fusion/core/both_views.h"
 
 namespace lidar_stereo_fusion {
 
@@ -192,24 +193,19 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
   // Stage 2: up-sampling (and the prior's confidence).
   auto t = Clock::now();
   ViewPrior left_prior, right_prior;
-  // The right view's prior is made beside the left's when more than one thread may run (its
-  // exceptions reach the caller through the future; its destructor waits if the left throws).
-  std::future<ViewPrior> right_future;
-  if (fused && params_.patchmatch.num_threads != 1) {
-    right_future = std::async(std::launch::async,
-                              [&] { return upsampleView(right_sparse, right_image, params_); });
-  }
-  if (usesLidar(method)) {
+  const auto left_view = [&] {
+    if (!usesLidar(method)) return;
     left_prior = upsampleView(left_sparse, left_image, params_);
     stats.points_removed = left_prior.removed;
     result.prior = left_prior.prior;
     result.confidence = left_prior.confidence;
     stats.prior_coverage = coverage(result.prior);
-  }
-  if (right_future.valid()) {
-    right_prior = right_future.get();
-  } else if (fused) {
-    right_prior = upsampleView(right_sparse, right_image, params_);
+  };
+  if (fused) {  // the right view's prior is made beside the left's
+    bothViews(params_.patchmatch.num_threads != 1 ? 2 : 1, left_view,
+              [&] { right_prior = upsampleView(right_sparse, right_image, params_); });
+  } else {
+    left_view();
   }
   stats.upsampling_ms = msSince(t);
 

@@ -12,10 +12,10 @@
 // else the left-right check is the 1/2-size level's, up-sampled.
 #include <algorithm>
 #include <cmath>
-#include <future>
 #include <stdexcept>
 #include <string>
 
+#include "lidar_stereo_fusion/core/both_views.h"
 #include "lidar_stereo_fusion/core/patchmatch.h"
 #include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
 #include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
@@ -35,21 +35,6 @@ std::vector<uint8_t> lockedToPrior(const patchmatch::ViewState& v) {
   std::vector<uint8_t> keep(v.locked.size());
   for (size_t i = 0; i < keep.size(); ++i) keep[i] = v.locked[i] == patchmatch::kLockedToPrior;
   return keep;
-}
-
-/// Runs the two views' independent steps, the right one beside the left with more than one
-/// thread (its exceptions reach here through the future, whose destructor waits if the left
-/// throws).
-template <class Left, class Right>
-void bothViews(int threads, Left&& left, Right&& right) {
-  std::future<void> right_done;
-  if (threads > 1) {
-    right_done = std::async(std::launch::async, right);
-  } else {
-    right();
-  }
-  left();
-  if (right_done.valid()) right_done.get();
 }
 
 cv::Mat3f planeMap(const patchmatch::ViewState& v, int threads) {
