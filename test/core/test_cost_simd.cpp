@@ -63,7 +63,8 @@ void randomPrior(int w, int h, std::mt19937& rng, cv::Mat1f& prior, cv::Mat1f& c
 
 /// C(p, plane) of cost.h in double precision, straight from the equations, on the view's texels
 /// (colour and gradient in the kernels' fixed point, the match interpolated as they do). w is the
-/// implementation's: exp(-l / delta) with l the RGB L1 distance rounded down to 1/4 (its LUT).
+/// implementation's: exp(-l / delta) with l the RGB L1 distance of the texels' colours (to 1/64
+/// with image_smoothing) rounded down to 1/4 (its LUT).
 /// Whether the window uses offset o: a multiple of the stride, and with dyadic sampling 0 or the
 /// stride times a power of two.
 bool usedOffset(const lsf::PatchMatchParams& p, int o) {
@@ -77,16 +78,18 @@ double referenceCost(const lsf::PatchMatchParams& p, const pm::ViewState& self,
                      const pm::ViewState& other, int px, int py, const pm::Plane& plane) {
   const bool use_prior = p.gamma > 0 && !self.prior.empty();
   const double alpha = p.alpha, beta = p.beta, gamma = p.gamma;
-  const cv::Vec3f center = self.color(py, px);
+  // The colour a texel holds (cost_kernel.h), 0..255.
+  const auto colour = [&](int x, int y, int i) {
+    return double(self.texels[static_cast<size_t>(y) * self.width + x].v[i]) / pm::kTexelScale;
+  };
   double sum = 0;
   for (int dy = -p.window_radius; dy <= p.window_radius; ++dy) {
     for (int dx = -p.window_radius; dx <= p.window_radius; ++dx) {
       const int x = px + dx, y = py + dy;
       if (!usedOffset(p, dy) || !usedOffset(p, dx)) continue;
       if (x < 0 || y < 0 || x >= self.width || y >= self.height) continue;
-      const cv::Vec3f c = self.color(y, x);
       double l1 = 0;
-      for (int i = 0; i < 3; ++i) l1 += std::abs(double(c[i]) - center[i]);
+      for (int i = 0; i < 3; ++i) l1 += std::abs(colour(x, y, i) - colour(px, py, i));
       const double w = std::exp(-std::min(std::floor(l1 * 4), 4095.0) / 4 / p.weight_delta);
       const double d = double(plane.a) * x + double(plane.b) * y + plane.c;
       const double xm = x + self.match_sign * d;

@@ -53,6 +53,24 @@ TEST(PatchMatch, RecoversFrontoParallelPlane) {
   EXPECT_LT(meanError(r.disparity, s, 8), 0.05) << "seed " << seed;
 }
 
+TEST(PatchMatch, SmoothingKeepsHalfPixelDisparitiesFromLockingToWholePixels) {
+  // Linear interpolation of the other view attenuates fine texture most half-way between pixels,
+  // which pulls the cost's minimum toward whole-pixel disparities; image_smoothing band-limits
+  // the images first. A plane at a half-pixel disparity, with and without it.
+  const uint64_t seed = 7;
+  const PlaneScene s = PlaneScene::make(240, 120, 0.0, 0.0, 20.5, seed);
+  auto p = stereoOnly();
+  lsf::PatchMatchStereo smoothed(p);
+  const double with = meanError(
+      smoothed.compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}}).disparity, s, 8);
+  p.image_smoothing = 0.0;
+  lsf::PatchMatchStereo raw(p);
+  const double without = meanError(
+      raw.compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}}).disparity, s, 8);
+  EXPECT_LT(with, 0.05);
+  EXPECT_LT(with, 0.5 * without);
+}
+
 TEST(PatchMatch, RecoversSlantedPlane) {
   const uint64_t seed = 11;
   // d = 0.08 x + 0.05 y + 6: a ground-like slant in both directions.

@@ -25,6 +25,11 @@ struct PatchMatchParams {
   /// sparse at the rim; 7x7 instead of 9x9 samples for the 17x17 window, for 40 % less cost work.
   bool window_dyadic = true;
   double weight_delta = 10.0;    ///< delta of w = exp(-|I_p - I_p'|_1 / delta)
+  /// [px] sigma of a 3x3 Gaussian applied to both images before matching (0 = off). Linear
+  /// interpolation of the other view at a sub-pixel match attenuates fine texture, which pulls
+  /// the cost's minimum toward whole-pixel disparities ("pixel locking"); a band-limited image
+  /// interpolates nearly exactly. The paper preset: 0.
+  double image_smoothing = 1.0;
   /// Weights of colour, gradient and LiDAR terms, alpha + beta + gamma = 1. The paper: 0.1, 0,
   /// 0.9. Default: gamma 0.9 where the LiDAR is sure, and an image term of Bleyer's mix (1 : 9
   /// colour : gradient), which confidence weighting renormalises to full weight without LiDAR.

@@ -60,6 +60,7 @@ void visitParamTable(P& p, V&& v) {
   v(ParamName{"window_stride", pm}, m.window_stride);
   v(ParamName{"window_dyadic", pm}, m.window_dyadic);
   v(ParamName{"weight_delta", pm}, m.weight_delta);
+  v(ParamName{"image_smoothing", pm}, m.image_smoothing);
   v(ParamName{"alpha", pm}, m.alpha);
   v(ParamName{"beta", pm}, m.beta);
   v(ParamName{"gamma", pm}, m.gamma);

@@ -56,6 +56,8 @@ void PatchMatchParams::validate() const {
   require(window_stride >= 1 && window_stride <= window_radius,
           "window_stride must be in [1, window_radius]");
   require(weight_delta > 0, "weight_delta must be > 0");
+  require(std::isfinite(image_smoothing) && image_smoothing >= 0 && image_smoothing <= 5,
+          "image_smoothing must be in [0, 5] px");
   require(alpha >= 0 && beta >= 0 && gamma >= 0, "alpha, beta, gamma must be >= 0");
   require(std::abs(alpha + beta + gamma - 1.0) < 1e-6, "alpha + beta + gamma must be 1");
   require(!confidence_weighting || alpha + beta > 0,

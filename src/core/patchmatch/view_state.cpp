@@ -41,10 +41,11 @@ void imageRange(const ViewInput& in, const PatchMatchParams& p, float& d_min, fl
   if (d_max <= d_min) d_max = d_min + 2.f * margin + 1e-3f;
 }
 
-/// The view's colour (v.color) and, if use_grad, the gradients of its grey image (central
-/// differences, (I(x+1) - I(x-1)) / 2; else left empty), which only the texels keep.
-void prepareImages(const ViewInput& in, bool use_grad, ViewState& v, cv::Mat1f& gx,
-                   cv::Mat1f& gy) {
+/// The view's colour (v.color), smoothed by a 3x3 Gaussian of sigma `smoothing` [px] if > 0
+/// (PatchMatchParams::image_smoothing), and, if use_grad, the gradients of its grey image
+/// (central differences, (I(x+1) - I(x-1)) / 2; else left empty), which only the texels keep.
+void prepareImages(const ViewInput& in, double smoothing, bool use_grad, ViewState& v,
+                   cv::Mat1f& gx, cv::Mat1f& gy) {
   cv::Mat bgr;
   if (in.image.channels() == 1) {
     cv::cvtColor(in.image, bgr, cv::COLOR_GRAY2BGR);
@@ -52,6 +53,9 @@ void prepareImages(const ViewInput& in, bool use_grad, ViewState& v, cv::Mat1f& 
     bgr = in.image;
   }
   bgr.convertTo(v.color, CV_32FC3);
+  if (smoothing > 0) {
+    cv::GaussianBlur(v.color, v.color, cv::Size(3, 3), smoothing, smoothing, cv::BORDER_REPLICATE);
+  }
   if (!use_grad) return;
   cv::Mat grey;
   cv::cvtColor(v.color, grey, cv::COLOR_BGR2GRAY);
@@ -76,9 +80,9 @@ void prepareTexels(const cv::Mat1f& gx, const cv::Mat1f& gy, ViewState& v) {
     Texel* row = &v.texels[static_cast<size_t>(y) * v.width];
     for (int x = 0; x < v.width; ++x) {
       short* t = row[x].v;
-      // Colours are whole numbers: exact. |gradient| <= 127.5 (half a grey difference): at most
-      // 8160 in fixed point, rounded half away from zero.
-      for (int c = 0; c < 3; ++c) t[c] = static_cast<short>(crow[x][c] * scale);
+      // Colours 0..255: exact if whole numbers (no image_smoothing), else to 1/64. |gradient| <=
+      // 127.5 (half a grey difference): at most 8160 in fixed point. Rounded half away from zero.
+      for (int c = 0; c < 3; ++c) t[c] = toFixed(crow[x][c] * scale);
       t[3] = 0;
       t[4] = gxrow != nullptr ? toFixed(gxrow[x] * scale) : 0;
       t[5] = gyrow != nullptr ? toFixed(gyrow[x] * scale) : 0;
@@ -152,7 +156,7 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
   v.height = in.image.rows;
   v.match_sign = match_sign;
   cv::Mat1f gx, gy;
-  prepareImages(in, p.beta > 0, v, gx, gy);
+  prepareImages(in, p.image_smoothing, p.beta > 0, v, gx, gy);
   prepareTexels(gx, gy, v);
   v.prior = in.prior;
   prepareTrust(in, p, v);

@@ -15,8 +15,9 @@
 //    Where the LiDAR is sure (c = 1) this is the paper's phi; where it fades the image term is
 //    renormalised to full weight, so that with no LiDAR it is plain stereo (Bleyer et al.).
 // A sample whose match falls outside the other image costs the colour/gradient truncations.
-// Colours and gradients are read in 16-bit fixed point (cost_kernel.h: colours exactly, gradients
-// and I_q interpolated at q to 1/64), so that the AVX2 kernel handles two samples per operation.
+// Colours and gradients are read in 16-bit fixed point (cost_kernel.h: to 1/64, colours exactly
+// without image_smoothing; I_q interpolated at q to 1/64), so that the AVX2 kernel handles two
+// samples per operation.
 #pragma once
 
 #include <vector>

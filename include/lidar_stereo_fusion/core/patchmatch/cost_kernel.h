@@ -10,9 +10,9 @@ namespace patchmatch {
 
 /// Channels per pixel in ViewState::texels and per sample in WindowCache::texels:
 /// B, G, R, 0, gx, gy, 0, 0 (colour 0..255, gradient of the grey image; 0 without gradient),
-/// each in 16-bit fixed point with kTexelScale steps per unit (colour exactly, gradient to
-/// 1/64; the nodes' differences, +- 2 255 64, and a difference moved by the sub-pixel step stay
-/// within 16 bits): one sample's two interpolation nodes fill 256 bits.
+/// each in 16-bit fixed point with kTexelScale steps per unit (to 1/64; colours exactly without
+/// image_smoothing; the nodes' differences, +- 2 255 64, and a difference moved by the sub-pixel
+/// step stay within 16 bits): one sample's two interpolation nodes fill 256 bits.
 constexpr int kTexelChannels = 8;
 constexpr int kTexelScale = 64;
 /// One texel, 16-byte aligned (std::vector<Texel> allocates with that alignment in C++17).
