@@ -21,7 +21,7 @@ constexpr uint8_t kSettledByGuide = 2;
 struct ViewState {
   int width = 0, height = 0;
   float match_sign = -1.f;  ///< the match of x is at x + sign * d in the other view
-  cv::Mat3f color;          ///< BGR float, 0..255 (the fill's weights; the cost reads texels)
+  cv::Mat3f color;          ///< BGR float, 0..255, after image_smoothing (the fill's weights)
   cv::Mat1f prior;          ///< up-sampled LiDAR disparity [px], 0 = empty (may be empty())
   /// Weight [0, 1] of the prior per pixel: the prior's confidence with confidence_weighting, else
   /// 1 where the prior has a value (the paper). Empty when there is no prior.
