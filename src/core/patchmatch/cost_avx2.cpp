@@ -32,31 +32,19 @@ constexpr int kMaxOffsets = 101;  // window_radius <= 50 (PatchMatchParams::vali
 constexpr int kPairs = kSimdBlock / 2;
 
 /// Calls f(PairIndex<p>()) for the pairs p < pairs that hold a real sample (p < kPairs; the
-/// shuffles that pick a pair's lanes take p as an immediate) and sets sums[p] to zero for the
-/// others. Only a window's last block has pairs of padding alone; their zero-weight terms are 0
-/// either way, so skipping them changes no float (a 7 x 7 window's last block holds 1 sample).
+/// shuffles that pick a pair's lanes take p as an immediate); the callers' sums start at zero for
+/// the others. Only a window's last block has pairs of padding alone; their zero-weight terms are
+/// 0 either way, so skipping them changes no float (a 7 x 7 window's last block holds 1 sample).
 template <int p>
 struct PairIndex {
   static constexpr int value = p;
 };
 template <class F>
-inline void forRealPairs(int pairs, __m256i* sums, F&& f) {
+inline void forRealPairs(int pairs, F&& f) {
   f(PairIndex<0>());  // a block holds at least one real sample
-  if (pairs > 1) {
-    f(PairIndex<1>());
-  } else {
-    sums[1] = _mm256_setzero_si256();
-  }
-  if (pairs > 2) {
-    f(PairIndex<2>());
-  } else {
-    sums[2] = _mm256_setzero_si256();
-  }
-  if (pairs > 3) {
-    f(PairIndex<3>());
-  } else {
-    sums[3] = _mm256_setzero_si256();
-  }
+  if (pairs > 1) f(PairIndex<1>());
+  if (pairs > 2) f(PairIndex<2>());
+  if (pairs > 3) f(PairIndex<3>());
 }
 
 /// The pairs of the block starting at sample s that hold a real sample (pair p holds p and
@@ -189,6 +177,10 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
     }
     const short* texel_row = texels + (static_cast<long>(y) * s.width + px) * kTexelChannels;
     __m128i* own = reinterpret_cast<__m128i*>(out.texels + k * kTexelChannels);
+    const auto copy_texel = [&](int j, int col) {
+      _mm_store_si128(own + j, _mm_load_si128(reinterpret_cast<const __m128i*>(
+                                   texel_row + col * kTexelChannels)));
+    };
     float* priors = out.priors + k;
     float* trusts = out.w_lidar + k;
     if (prior != nullptr) {  // one pass over the columns for texel, prior and trust
@@ -196,15 +188,13 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
       const float* trust_row = trust + static_cast<long>(y) * s.trust_step + px;
       for (int j = 0; j < m; ++j) {
         const int col = cols[j];
-        _mm_store_si128(own + j, _mm_load_si128(reinterpret_cast<const __m128i*>(
-                                     texel_row + col * kTexelChannels)));
+        copy_texel(j, col);
         priors[j] = prior_row[col];
         trusts[j] = trust_row[col];
       }
     } else {
       for (int j = 0; j < m; ++j) {
-        _mm_store_si128(own + j, _mm_load_si128(reinterpret_cast<const __m128i*>(
-                                     texel_row + cols[j] * kTexelChannels)));
+        copy_texel(j, cols[j]);
         priors[j] = trusts[j] = 0.f;
       }
     }
@@ -243,8 +233,8 @@ int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& 
   alignas(32) float empty_cost[kSimdBlock];
   for (int b = 0; b < padded; b += kSimdBlock) {
     // The RGB L1 distance to the centre, in texel units (exact integers).
-    __m256i pair_sums[kPairs];
-    forRealPairs(realPairs(count, b), pair_sums, [&](auto pair) {
+    __m256i pair_sums[kPairs] = {};
+    forRealPairs(realPairs(count, b), [&](auto pair) {
       constexpr int p = decltype(pair)::value;
       const __m256i diff = _mm256_abs_epi16(
           _mm256_sub_epi16(pairOf(out.texels + b * kTexelChannels, p), center));
@@ -298,8 +288,8 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
     // Each float operation as the baseline code does it (no FMA; -ffp-contract=off here).
     const BlockMatch m = matchBlock(w, k, s, va, vb, vc, node);
     const short* own = w.texels + s * kTexelChannels;
-    __m256i pair_sums[kPairs];
-    forRealPairs(realPairs(w.real_count, s), pair_sums, [&](auto pair) {
+    __m256i pair_sums[kPairs] = {};
+    forRealPairs(realPairs(w.real_count, s), [&](auto pair) {
       constexpr int p = decltype(pair)::value;
       __m256i slope, diff;
       const __m256i l1 = pairDifference(k.other_texels, node, own, p, m.fractions, slope, diff);
@@ -335,9 +325,8 @@ void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a
     const BlockMatch m = matchBlock(w, k, s, va, vb, vc, node);
     const short* own = w.texels + s * kTexelChannels;
     // own - m at d -+ h: own - m +- the nodes' difference times the shift, on d's interval.
-    __m256i sums_lower[kPairs], sums_upper[kPairs];
-    const int pairs = realPairs(w.real_count, s);
-    forRealPairs(pairs, sums_lower, [&](auto pair) {
+    __m256i sums_lower[kPairs] = {}, sums_upper[kPairs] = {};
+    forRealPairs(realPairs(w.real_count, s), [&](auto pair) {
       constexpr int p = decltype(pair)::value;
       __m256i slope, diff;
       pairDifference(k.other_texels, node, own, p, m.fractions, slope, diff);
@@ -345,7 +334,6 @@ void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a
       sums_lower[p] = _mm256_madd_epi16(_mm256_abs_epi16(_mm256_add_epi16(diff, moved)), ones);
       sums_upper[p] = _mm256_madd_epi16(_mm256_abs_epi16(_mm256_sub_epi16(diff, moved)), ones);
     });
-    for (int p = pairs; p < kPairs; ++p) sums_upper[p] = _mm256_setzero_si256();
     __m256 col_lower, grad_lower, col_upper, grad_upper;
     channelSums(sums_lower, col_lower, grad_lower);
     channelSums(sums_upper, col_upper, grad_upper);
