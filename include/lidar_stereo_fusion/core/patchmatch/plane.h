@@ -37,11 +37,15 @@ inline Plane transferPlane(const Plane& p, bool left_to_right) {
 
 constexpr float kSamePlaneTolerance = 0.01f;  ///< [px]
 
-/// True when two planes agree to kSamePlaneTolerance px at (x, y) and to 1e-3 in slope:
-/// evaluating one after the other cannot change the result meaningfully.
+/// True when two planes have the same slope to 1e-3 px/px in x and y.
+inline bool parallel(const Plane& p, const Plane& q) {
+  return std::abs(p.a - q.a) < 1e-3f && std::abs(p.b - q.b) < 1e-3f;
+}
+
+/// True when two planes agree to kSamePlaneTolerance px at (x, y) and are parallel: evaluating
+/// one after the other cannot change the result meaningfully.
 inline bool nearlySame(const Plane& p, const Plane& q, float x, float y) {
-  return std::abs(p.at(x, y) - q.at(x, y)) < kSamePlaneTolerance && std::abs(p.a - q.a) < 1e-3f &&
-         std::abs(p.b - q.b) < 1e-3f;
+  return std::abs(p.at(x, y) - q.at(x, y)) < kSamePlaneTolerance && parallel(p, q);
 }
 
 /// Counter-based random numbers (splitmix64): deterministic per (seed, stream), so results do not

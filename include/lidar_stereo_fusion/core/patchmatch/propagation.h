@@ -70,7 +70,8 @@ class PlaneSearch {
   void polishSettled(int x, int y, int idx, int iteration, WindowCache& cache) const;
 
   /// Whether tryPlane would evaluate `candidate` against `current`: admissible at (x, y), not
-  /// nearlySame and not within SearchOptions::tolerance.
+  /// nearlySame, not within SearchOptions::tolerance and, where the sub-pixel step ends the
+  /// search, not parallel to `current` within its step kMinRefineStep at (x, y).
   bool worthTrying(int x, int y, const Plane& candidate, const Plane& current) const;
 
   /// Replaces (best, best_cost) by `candidate` when it is admissible and cheaper.
