@@ -143,9 +143,12 @@ bool PlaneSearch::worthTrying(int x, int y, const Plane& candidate, const Plane&
   const float shift = std::abs(d - current.at(fx, fy));
   if (options_.tolerance > 0.f && shift <= options_.tolerance) return false;
   // The sub-pixel step ending the search probes the current plane moved by -+ kMinRefineStep and
-  // fits the cost's vertex between: a parallel candidate moved by no more than that lies on the
-  // interval it searches (a fifth of the full-size candidates; KITTI and Middlebury unchanged).
-  if (options_.subpixel && shift <= kMinRefineStep && parallel(candidate, current)) return false;
+  // fits the cost's vertex between: a parallel candidate moved by no more than half that lies
+  // well inside the interval it searches. (Up to the whole step, far surfaces lost precision:
+  // the fit is least reliable near the interval's ends.)
+  if (options_.subpixel && shift <= 0.5f * kMinRefineStep && parallel(candidate, current)) {
+    return false;
+  }
   return !nearlySame(candidate, current, fx, fy) && admissible(x, y, d);
 }
 

@@ -71,7 +71,7 @@ class PlaneSearch {
 
   /// Whether tryPlane would evaluate `candidate` against `current`: admissible at (x, y), not
   /// nearlySame, not within SearchOptions::tolerance and, where the sub-pixel step ends the
-  /// search, not parallel to `current` within its step kMinRefineStep at (x, y).
+  /// search, not parallel to `current` within half its step kMinRefineStep at (x, y).
   bool worthTrying(int x, int y, const Plane& candidate, const Plane& current) const;
 
   /// Replaces (best, best_cost) by `candidate` when it is admissible and cheaper.
