@@ -90,6 +90,46 @@ TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {
   EXPECT_EQ(w.left.locked[0 * 6 + 1], 0);
 }
 
+TEST(PatchMatchCoarseStart, InconsistentPixelsWithoutBoundsAreLeftToTheFill) {
+  const lsf::PatchMatchParams p = params3x3();
+  lsf::ScanLineBounds b;
+  b.lo = cv::Mat1f::zeros(4, 6);
+  b.hi = cv::Mat1f::zeros(4, 6);
+  b.range = cv::Mat1f::zeros(4, 6);
+  for (int x = 0; x < 6; ++x) b.hi(2, x) = b.lo(2, x) = 5.f;  // row 2 lies between scan lines
+  cv::Mat1f prior = cv::Mat1f::zeros(4, 6), conf = cv::Mat1f::zeros(4, 6);
+  prior(3, 0) = 5.f;
+  conf(3, 0) = 1.f;  // one pixel locked to the prior
+  Views v = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
+  pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, v.left);
+  cv::Mat1b inconsistent(4, 6, uchar(255));
+  inconsistent(1, 4) = 0;
+  pm::leaveToFill(inconsistent, v.left);
+  EXPECT_EQ(v.left.locked[0 * 6 + 1], pm::kLeftToFill);
+  EXPECT_EQ(v.left.locked[1 * 6 + 4], 0);                   // consistent: searched
+  EXPECT_EQ(v.left.locked[2 * 6 + 1], 0);                   // bounded: searched
+  EXPECT_EQ(v.left.locked[3 * 6 + 0], pm::kLockedToPrior);  // the prior's, kept
+  pm::SearchOptions polish;
+  polish.refine = false;
+  polish.subpixel = true;
+  const pm::PlaneSearch search(p, v.left, v.right, polish);
+  pm::Rng rng(3);
+  EXPECT_EQ(search.initialPlane(1, 0, rng).c, 7.f);  // the level below's plane
+  // Not searched: it takes the plane before it in the sweep, whose cost here is unknown.
+  v.left.planes[0 * 6 + 0] = pm::Plane{0.f, 0.f, 9.f};
+  v.left.planes[0 * 6 + 2] = pm::Plane{0.f, 0.f, 5.f};
+  pm::WindowCache cache;
+  search.processPixel(1, 0, true, 0, cache);
+  EXPECT_EQ(v.left.planes[0 * 6 + 1].c, 9.f);
+  EXPECT_EQ(v.left.cost[0 * 6 + 1], pm::kUnknownCost);
+  search.processPixel(1, 0, false, 1, cache);
+  EXPECT_EQ(v.left.planes[0 * 6 + 1].c, 5.f);
+  EXPECT_EQ(cache.count, 0);  // no window was built
+  v.left.planes[0 * 6 + 0] = pm::Plane{0.f, 0.f, 7.f};
+  search.processPixel(0, 0, true, 0, cache);  // nothing before it: keeps its plane
+  EXPECT_EQ(v.left.planes[0 * 6 + 0].c, 7.f);
+}
+
 TEST(PatchMatchCoarseStart, PlanesScaleToFullSizeAndViewsReduceExactly) {
   cv::Mat3f coarse(2, 3, cv::Vec3f(0.f, 0.f, 0.f));
   coarse(1, 2) = cv::Vec3f(0.5f, 0.25f, 3.f);

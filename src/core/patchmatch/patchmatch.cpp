@@ -9,7 +9,8 @@
 // and filling. At the full-size level after a coarse start, the left view polishes each pixel's
 // plane with a sub-pixel step (fine_subpixel), after a random refinement only if fine_refine; the
 // right view is searched only if asked (fine_right_view, or fine_lr_check: by propagation alone),
-// else the left-right check is the 1/2-size level's, up-sampled.
+// else the left-right check is the 1/2-size level's, up-sampled, and the pixels without LiDAR
+// bounds it marks inconsistent are left to the hole filling (not searched, leaveToFill).
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -140,6 +141,9 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
         inconsistent = upsampleMask(leftRightCheck(coarse.disparity, coarse.right_disparity,
                                                    max_diff, {}, unmatched_bad, threads),
                                     p.coarse_scale, size);
+        // The fill replaces these pixels' disparity, whatever the search would find: a third of
+        // the full-size search on KITTI frame 0 (85k pixels, most above the LiDAR's view).
+        leaveToFill(inconsistent, lv);
       }
     }
   }

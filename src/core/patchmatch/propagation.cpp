@@ -37,7 +37,10 @@ void PlaneSearch::initRange(int x, int y, float& lo, float& hi) const {
 Plane PlaneSearch::initialPlane(int x, int y, Rng& rng) const {
   const int idx = y * self_.width + x;
   if (self_.locked[idx] == kLockedToPrior) return priorPlane(self_, x, y);
-  if (self_.locked[idx] == kSettledByGuide) return self_.guide[idx];
+  if (self_.locked[idx] == kSettledByGuide ||
+      (self_.locked[idx] == kLeftToFill && !self_.guide.empty())) {
+    return self_.guide[idx];
+  }
   if (!self_.guide.empty()) {
     const Plane& g = self_.guide[idx];
     if (admissible(x, y, g.at(static_cast<float>(x), static_cast<float>(y)))) return g;
@@ -86,6 +89,15 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   // Spatial propagation: forward sweeps look left/up, backward sweeps right/down.
   const int step = forward ? -1 : 1;
   const int nx = x + step, ny = y + step;
+  if (self_.locked[idx] == kLeftToFill) {
+    // Not searched (the fill replaces it): it passes the plane before it in the row on, so that
+    // the next searched pixel is offered the last searched plane, as if the search had kept it.
+    if (nx >= 0 && nx < self_.width) {
+      self_.planes[idx] = self_.planes[idx + step];
+      self_.cost[idx] = kUnknownCost;
+    }
+    return;
+  }
   const bool has_x = nx >= 0 && nx < self_.width, has_y = ny >= 0 && ny < self_.height;
   if (options_.tolerance > 0.f && !options_.refine && !options_.subpixel) {
     // Propagation alone with a tolerance: no window unless some candidate is worth a cost.

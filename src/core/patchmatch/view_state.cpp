@@ -192,6 +192,16 @@ void setGuide(std::vector<Plane> guide, const PatchMatchParams& p, ViewState& v)
   }
 }
 
+void leaveToFill(const cv::Mat1b& inconsistent, ViewState& v) {
+  for (int y = 0; y < v.height; ++y) {
+    const uchar* bad = inconsistent[y];
+    for (int x = 0; x < v.width; ++x) {
+      uint8_t& l = v.locked[y * v.width + x];
+      if (bad[x] && l != kLockedToPrior && !v.bounded(x, y)) l = kLeftToFill;
+    }
+  }
+}
+
 void checkViewInput(const ViewInput& v, const cv::Size& size, const char* which) {
   const std::string name(which);
   if (v.image.empty()) throw std::invalid_argument(name + " image is empty");

@@ -16,6 +16,9 @@
 //    the bounds already.
 //  * Locked pixels (prior confidence >= lock_confidence) keep the prior's plane: they are not
 //    searched and receive no view propagation, but offer their plane to their neighbours.
+//  * At the full-size level after a coarse start whose left-right check is the level's result,
+//    pixels without scan-line bounds that check marks inconsistent are left to the hole filling
+//    (leaveToFill): not searched, they pass the plane before them in the row on.
 //  * Parallelism: the image is cut into horizontal strips of kStripRows rows processed in two
 //    phases (every second strip in parallel, then the others), each strip swept in the paper's
 //    order. A second-phase strip starts as soon as its two neighbours are done, without waiting
@@ -61,7 +64,8 @@ class PlaneSearch {
   /// One step of a sweep at (x, y): spatial propagation from the left/upper (forward) or
   /// right/lower neighbour, then plane refinement and/or the sub-pixel step (SearchOptions; with
   /// neither, propagation only). Does nothing on a pixel locked to the prior;
-  /// polishes a pixel settled by the coarse level (polishSettled).
+  /// polishes a pixel settled by the coarse level (polishSettled); a pixel left to the fill
+  /// (leaveToFill) takes the plane of the pixel before it in the row, unevaluated.
   void processPixel(int x, int y, bool forward, int iteration, WindowCache& cache) const;
 
   /// Plane refinement and/or the sub-pixel step alone (no spatial propagation) of a pixel settled
