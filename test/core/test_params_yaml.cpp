@@ -76,6 +76,7 @@ FusionParams everyFieldChanged() {
   m.coarse_scale = 3;
   m.coarse_levels = 3;
   m.full_size_unbounded = true;
+  m.skip_inconsistent = false;
   m.fine_iterations = 2;
   m.fine_refine_range = 1.5;
   p.confidence.edge_tolerance = 0.25;
@@ -133,6 +134,7 @@ void expectSame(const FusionParams& a, const FusionParams& b) {
   EXPECT_EQ(x.coarse_scale, y.coarse_scale);
   EXPECT_EQ(x.coarse_levels, y.coarse_levels);
   EXPECT_EQ(x.full_size_unbounded, y.full_size_unbounded);
+  EXPECT_EQ(x.skip_inconsistent, y.skip_inconsistent);
   EXPECT_EQ(x.fine_iterations, y.fine_iterations);
   EXPECT_EQ(x.fine_refine_range, y.fine_refine_range);
   const PriorConfidenceParams &c = a.confidence, &d = b.confidence;

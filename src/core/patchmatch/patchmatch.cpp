@@ -9,12 +9,16 @@
 // and filling. At the full-size level after a coarse start, the left view polishes each pixel's
 // plane with a sub-pixel step (fine_subpixel), after a random refinement only if fine_refine; the
 // right view is searched only if asked (fine_right_view, or fine_lr_check: by propagation alone),
-// else the left-right check is the 1/2-size level's, up-sampled, and the pixels without LiDAR
-// bounds it marks inconsistent are left to the hole filling (not searched, leaveToFill).
+// else the left-right check is the 1/2-size level's, up-sampled. After a coarse start, the pixels
+// without LiDAR bounds that the level below's left-right check marks inconsistent are not searched
+// (skip_inconsistent; at 1/2 size the interior of those regions only): they pass the plane before
+// them on, as the hole filling would (leaveToFill).
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include <opencv2/imgproc.hpp>
 
 #include "lidar_stereo_fusion/core/both_views.h"
 #include "lidar_stereo_fusion/core/patchmatch.h"
@@ -133,17 +137,33 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
       setGuide(upsamplePlanes(coarse.right_planes, p.coarse_scale, size, threads), p, rv);
     }
     iterations = p.fine_iterations;
+    // The level below's left-right check (its views, at lr_max_diff / coarse_scale).
+    cv::Mat1b below;
+    if (!coarse.right_disparity.empty() && (p.skip_inconsistent || (p.lr_check && !right_view))) {
+      const float max_diff = static_cast<float>(p.lr_max_diff / p.coarse_scale);
+      below = leftRightCheck(coarse.disparity, coarse.right_disparity, max_diff, {},
+                             unmatched_bad, threads);
+    }
     if (p.lr_check && !right_view) {
-      if (coarse.right_disparity.empty()) {
+      if (below.empty()) {
         right_view = true;  // no view propagation below: only a full-size right view can check
       } else {
-        const float max_diff = static_cast<float>(p.lr_max_diff / p.coarse_scale);
-        inconsistent = upsampleMask(leftRightCheck(coarse.disparity, coarse.right_disparity,
-                                                   max_diff, {}, unmatched_bad, threads),
-                                    p.coarse_scale, size);
-        // The fill replaces these pixels' disparity, whatever the search would find: a third of
-        // the full-size search on KITTI frame 0 (85k pixels, most above the LiDAR's view).
+        inconsistent = upsampleMask(below, p.coarse_scale, size);
+      }
+    }
+    if (p.skip_inconsistent && !below.empty()) {
+      if (!inconsistent.empty()) {
+        // The fill replaces these pixels' disparity whatever the search finds (a third of the
+        // full-size search on KITTI frame 0).
         leaveToFill(inconsistent, lv);
+      } else {
+        // This level's own check decides. Occluded or ambiguous below, they are mostly so here
+        // too, and spreading their neighbours' planes serves them as well as searching them; but
+        // the border of each region below, one of its pixels wide, is searched: coarse pixels
+        // straddle depth edges, and skipping them would erode foreground objects by up to one.
+        cv::Mat1b interior;
+        cv::erode(below, interior, cv::Mat());
+        leaveToFill(upsampleMask(interior, p.coarse_scale, size), lv);
       }
     }
   }

@@ -16,9 +16,9 @@
 //    the bounds already.
 //  * Locked pixels (prior confidence >= lock_confidence) keep the prior's plane: they are not
 //    searched and receive no view propagation, but offer their plane to their neighbours.
-//  * At the full-size level after a coarse start whose left-right check is the level's result,
-//    pixels without scan-line bounds that check marks inconsistent are left to the hole filling
-//    (leaveToFill): not searched, they pass the plane before them in the row on.
+//  * After a coarse start, pixels without scan-line bounds that the level below's left-right
+//    check marks inconsistent are left to the hole filling (skip_inconsistent, leaveToFill): not
+//    searched, they pass the plane before them in the row on.
 //  * Parallelism: the image is cut into horizontal strips of kStripRows rows processed in two
 //    phases (every second strip in parallel, then the others), each strip swept in the paper's
 //    order. A second-phase strip starts as soon as its two neighbours are done, without waiting
