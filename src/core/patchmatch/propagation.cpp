@@ -99,8 +99,10 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
     return;
   }
   const bool has_x = nx >= 0 && nx < self_.width, has_y = ny >= 0 && ny < self_.height;
-  if (options_.tolerance > 0.f && !options_.refine && !options_.subpixel) {
-    // Propagation alone with a tolerance: no window unless some candidate is worth a cost.
+  if (!options_.refine && !options_.subpixel) {
+    // Propagation alone: no window unless some candidate is worth a cost. (The pixel's own cost,
+    // unknown after initialisation, is then computed when first asked for, from the same
+    // window: the same float.)
     const Plane& own = self_.planes[idx];
     if (!(self_.offered[idx] && worthTrying(x, y, self_.offer[idx], own)) &&
         !(has_x && worthTrying(x, y, self_.planes[idx + step], own)) &&
