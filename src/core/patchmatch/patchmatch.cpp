@@ -160,7 +160,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
         // This level's own check decides. Occluded or ambiguous below, they are mostly so here
         // too, and spreading their neighbours' planes serves them as well as searching them; but
         // the border of each region below, one of its pixels wide, is searched: coarse pixels
-        // straddle depth edges, and skipping them would erode foreground objects by up to one.
+        // straddle depth edges, and skipping them would erode foreground objects by up to one
+        // coarse pixel (tested).
         cv::Mat1b interior;
         cv::erode(below, interior, cv::Mat());
         leaveToFill(upsampleMask(interior, p.coarse_scale, size), lv);

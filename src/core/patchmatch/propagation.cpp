@@ -90,8 +90,8 @@ void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
   const int step = forward ? -1 : 1;
   const int nx = x + step, ny = y + step;
   if (self_.locked[idx] == kLeftToFill) {
-    // Not searched (the fill replaces it): it passes the plane before it in the row on, so that
-    // the next searched pixel is offered the last searched plane, as if the search had kept it.
+    // Not searched (leaveToFill): it passes the plane before it in the row on, so that the next
+    // searched pixel is offered the last searched plane, as the hole filling would spread it.
     if (nx >= 0 && nx < self_.width) {
       self_.planes[idx] = self_.planes[idx + step];
       self_.cost[idx] = kUnknownCost;

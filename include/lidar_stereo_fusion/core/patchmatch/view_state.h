@@ -33,8 +33,8 @@ struct ViewState {
   std::vector<float> cost;
   /// Pixels that are not searched: kLockedToPrior where the plane is the prior's (trust >=
   /// lock_confidence), kSettledByGuide where it is the coarse level's (no scan-line bounds and
-  /// full_size_unbounded false), kLeftToFill where the hole filling will replace the disparity
-  /// (leaveToFill); 0 elsewhere.
+  /// full_size_unbounded false), kLeftToFill where the level below found the pixel
+  /// inconsistent (leaveToFill); 0 elsewhere.
   std::vector<uint8_t> locked;
   /// Planes of the coarse start, up-sampled (empty: none): the initial plane where admissible.
   std::vector<Plane> guide;
@@ -60,11 +60,12 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
 /// pixels without scan-line bounds that are not locked to the prior: they keep the guide's plane.
 void setGuide(std::vector<Plane> guide, const PatchMatchParams& p, ViewState& v);
 
-/// Marks the pixels of the left view that the left-right check of the level below marks
-/// `inconsistent`, that have no scan-line bounds and are not locked to the prior, kLeftToFill:
-/// the hole filling replaces their disparity whatever the search finds, so they are not searched
-/// (PlaneSearch::processPixel passes the plane before them on). Pixels between scan lines are
-/// searched even then: their planes, bounded by the LiDAR, carry the propagation along the row.
+/// Marks the pixels of the left view that are set in `inconsistent` (the level below's
+/// left-right check, up-sampled; PatchMatchParams::skip_inconsistent), have no scan-line bounds
+/// and are not locked to the prior, kLeftToFill: they are not searched, and each takes the plane
+/// before it in the row, as the hole filling would (PlaneSearch::processPixel). Pixels between
+/// scan lines are searched even then: their planes, bounded by the LiDAR, carry the propagation
+/// along the row.
 void leaveToFill(const cv::Mat1b& inconsistent, ViewState& v);
 
 /// Throws std::invalid_argument naming the problem when a view's input does not fit `size`.
