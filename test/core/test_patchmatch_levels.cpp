@@ -214,15 +214,21 @@ struct BoxScene {
   }
 };
 
-}  // namespace
-
-TEST(PatchMatchCoarseStart, TheLeftRightCheckRunsAtHalfSizeUnlessAsked) {
-  const BoxScene s = BoxScene::make(128, 64);
+/// Stereo alone (colour and gradient only), the box scene's disparity range.
+lsf::PatchMatchParams boxParams() {
   lsf::PatchMatchParams p;
   p.alpha = 0.5;
   p.beta = 0.5;
   p.gamma = 0.0;
   p.max_disparity = 24;
+  return p;
+}
+
+}  // namespace
+
+TEST(PatchMatchCoarseStart, TheLeftRightCheckRunsAtHalfSizeUnlessAsked) {
+  const BoxScene s = BoxScene::make(128, 64);
+  lsf::PatchMatchParams p = boxParams();
   for (const bool fine_lr_check : {false, true}) {
     p.fine_lr_check = fine_lr_check;
     lsf::PatchMatchStereo matcher(p);
@@ -255,11 +261,7 @@ TEST(PatchMatchCoarseStart, SkippingInconsistentPixelsKeepsForegroundEdges) {
   // 1/2 size. The 1/4-size pixels at the box's edges straddle them; skipping those too put the
   // background on 2-4 columns of the box (mean error 0.25 px over the visible pixels).
   const BoxScene s = BoxScene::make(128, 64);
-  lsf::PatchMatchParams p;
-  p.alpha = 0.5;
-  p.beta = 0.5;
-  p.gamma = 0.0;
-  p.max_disparity = 24;
+  lsf::PatchMatchParams p = boxParams();
   for (const bool skip : {false, true}) {
     p.skip_inconsistent = skip;
     lsf::PatchMatchStereo matcher(p);
