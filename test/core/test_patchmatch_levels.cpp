@@ -65,19 +65,30 @@ TEST(PatchMatchPostProcessing, AFillNeverPassesTheSearchRange) {
   EXPECT_EQ(disparity(0, 5), 140.f);  // the median of its window: pixels 3 (140) and 5 (180)
 }
 
-TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {
-  lsf::PatchMatchParams p = params3x3();
-  p.full_size_unbounded = false;
+namespace {
+
+/// 6x4 uniform views whose row 2 lies between scan lines (bounded) and whose pixel (0, 3) is
+/// locked to the prior, with the guide d = 7 everywhere.
+Views guided6x4(const lsf::PatchMatchParams& p) {
   lsf::ScanLineBounds b;
   b.lo = cv::Mat1f::zeros(4, 6);
   b.hi = cv::Mat1f::zeros(4, 6);
   b.range = cv::Mat1f::zeros(4, 6);
-  for (int x = 0; x < 6; ++x) b.hi(2, x) = b.lo(2, x) = 5.f;  // row 2 lies between scan lines
+  for (int x = 0; x < 6; ++x) b.hi(2, x) = b.lo(2, x) = 5.f;
   cv::Mat1f prior = cv::Mat1f::zeros(4, 6), conf = cv::Mat1f::zeros(4, 6);
   prior(3, 0) = 5.f;
-  conf(3, 0) = 1.f;  // one pixel locked to the prior
+  conf(3, 0) = 1.f;
   Views v = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
   pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, v.left);
+  return v;
+}
+
+}  // namespace
+
+TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {
+  lsf::PatchMatchParams p = params3x3();
+  p.full_size_unbounded = false;
+  Views v = guided6x4(p);
   EXPECT_EQ(v.left.locked[0 * 6 + 1], pm::kSettledByGuide);
   EXPECT_EQ(v.left.locked[2 * 6 + 1], 0);  // bounded: searched
   EXPECT_EQ(v.left.locked[3 * 6 + 0], pm::kLockedToPrior);
@@ -85,23 +96,13 @@ TEST(PatchMatchCoarseStart, UnboundedPixelsAreSettledByTheGuideUnlessAsked) {
   pm::Rng rng(3);
   EXPECT_EQ(search.initialPlane(1, 0, rng).c, 7.f);
   p.full_size_unbounded = true;
-  Views w = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
-  pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, w.left);
+  Views w = guided6x4(p);
   EXPECT_EQ(w.left.locked[0 * 6 + 1], 0);
 }
 
 TEST(PatchMatchCoarseStart, InconsistentPixelsWithoutBoundsAreLeftToTheFill) {
   const lsf::PatchMatchParams p = params3x3();
-  lsf::ScanLineBounds b;
-  b.lo = cv::Mat1f::zeros(4, 6);
-  b.hi = cv::Mat1f::zeros(4, 6);
-  b.range = cv::Mat1f::zeros(4, 6);
-  for (int x = 0; x < 6; ++x) b.hi(2, x) = b.lo(2, x) = 5.f;  // row 2 lies between scan lines
-  cv::Mat1f prior = cv::Mat1f::zeros(4, 6), conf = cv::Mat1f::zeros(4, 6);
-  prior(3, 0) = 5.f;
-  conf(3, 0) = 1.f;  // one pixel locked to the prior
-  Views v = prepare({uniform(6, 4, 30), prior, b, conf}, {uniform(6, 4, 30)}, p);
-  pm::setGuide(std::vector<pm::Plane>(24, pm::Plane{0.f, 0.f, 7.f}), p, v.left);
+  Views v = guided6x4(p);
   cv::Mat1b inconsistent(4, 6, uchar(255));
   inconsistent(1, 4) = 0;
   pm::leaveToFill(inconsistent, v.left);
