@@ -127,6 +127,28 @@ double referenceCost(const lsf::PatchMatchParams& p, const pm::ViewState& self,
   return sum;
 }
 
+/// The AVX2 window (interior or at a border) holds the baseline's samples, bit for bit, and
+/// zero weights on its padding.
+void expectSameWindow(const pm::WindowCache& fast, const pm::WindowCache& base, int px, int py) {
+  for (int k = 0; k < base.count; ++k) {
+    const auto where = ::testing::Message() << "pixel " << px << "," << py << " sample " << k;
+    ASSERT_EQ(fast.xs[k], base.xs[k]) << where;
+    ASSERT_EQ(fast.ys[k], base.ys[k]) << where;
+    ASSERT_EQ(fast.texel_row[k], base.texel_row[k]) << where;
+    ASSERT_EQ(fast.priors[k], base.priors[k]) << where;
+    ASSERT_EQ(fast.w_img[k], base.w_img[k]) << where;
+    ASSERT_EQ(fast.w_lidar[k], base.w_lidar[k]) << where;
+    for (int c = 0; c < pm::kTexelChannels; ++c) {
+      ASSERT_EQ(fast.texels[k].v[c], base.texels[k].v[c]) << where << " channel " << c;
+    }
+  }
+  for (int k = base.count; k < fast.padded; ++k) {
+    ASSERT_EQ(fast.w_img[k], 0.f) << "padding " << k;
+    ASSERT_EQ(fast.w_lidar[k], 0.f) << "padding " << k;
+  }
+  ASSERT_EQ(fast.constant, base.constant);
+}
+
 struct CostCase {
   bool weighted, with_prior, with_grad;
 };
@@ -171,6 +193,7 @@ void compareKernels(const CostCase& cc, uint32_t seed) {
       base.buildWindow(px, py, base_cache);
       ASSERT_EQ(fast_cache.count, base_cache.count);
       ASSERT_EQ(fast_cache.padded % pm::kSimdBlock, 0);
+      expectSameWindow(fast_cache, base_cache, px, py);
       const float inf = std::numeric_limits<float>::max();
       const float cf = fast.aggregate(fast_cache, plane, inf);
       const float cb = base.aggregate(base_cache, plane, inf);

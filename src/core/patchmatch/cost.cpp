@@ -68,6 +68,20 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   weighted_ = p_.confidence_weighting;
   img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
   avx2_ = activeSimdPath() == SimdPath::kAvx2;
+  // A window wholly inside the image has the same samples at the same offsets for every pixel.
+  const int m = static_cast<int>(offsets_.size());
+  const int other_stride = kTexelChannels * other_.width;
+  for (int k = 0; k < (m * m + kSimdBlock - 1) / kSimdBlock * kSimdBlock; ++k) {
+    const int i = k < m * m ? k : 0;  // the padding repeats the first sample
+    const int dy = offsets_[i / m], dx = offsets_[i % m];
+    interior_dx_.push_back(static_cast<float>(dx));
+    interior_dy_.push_back(static_cast<float>(dy));
+    interior_row_.push_back(dy * other_stride);
+    interior_texel_.push_back((dy * self_.width + dx) * kTexelChannels);
+    interior_pixel_.push_back(dy * self_.width + dx);
+  }
+  const bool pixel_steps = !use_prior_ || (static_cast<int>(self_.prior.step1()) == self_.width &&
+                                           static_cast<int>(self_.trust.step1()) == self_.width);
   const float x_max = static_cast<float>(self_.width - 1);
   kernel_self_ = KernelSelf{self_.texels.empty() ? nullptr : self_.texels.data()->v,
                             use_prior_ ? self_.prior.ptr<float>(0) : nullptr,
@@ -76,7 +90,7 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
                             use_prior_ ? static_cast<int>(self_.trust.step1()) : 0,
                             self_.width,
                             self_.height,
-                            kTexelChannels * other_.width,
+                            other_stride,
                             offsets_.data(),
                             static_cast<int>(offsets_.size()),
                             weight_lut_.data(),
@@ -85,7 +99,12 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
                             weighted_,
                             wg_,
                             img_norm_,
-                            ldisp_};
+                            ldisp_,
+                            interior_dx_.data(),
+                            interior_dy_.data(),
+                            interior_row_.data(),
+                            interior_texel_.data(),
+                            pixel_steps ? interior_pixel_.data() : nullptr};
   // The L1 sums are in texel units: alpha min(L1 / 64, lambda) = alpha / 64 min(L1, 64 lambda),
   // exactly (powers of two).
   const float scale = static_cast<float>(kTexelScale);

@@ -212,65 +212,138 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
   return k;
 }
 
+/// The RGB L1 distance to the centre of the 8 samples whose texels are in `pairs` ([t_p |
+/// t_{p + 4}], pairOf), in texel units (exact integers); pairs beyond `real_pairs` count 0.
+inline __m256 colourDistance(const __m256i* pairs, int real_pairs, __m256i center) {
+  const __m256i colour = _mm256_setr_epi16(1, 1, 1, 0, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0);
+  __m256i pair_sums[kPairs] = {};
+  forRealPairs(real_pairs, [&](auto pair) {
+    constexpr int p = decltype(pair)::value;
+    pair_sums[p] = _mm256_madd_epi16(_mm256_abs_epi16(_mm256_sub_epi16(pairs[p], center)), colour);
+  });
+  __m256 l1, unused;
+  channelSums(pair_sums, l1, unused);
+  return l1;
+}
+
+/// w_img and w_lidar of the block of 8 samples starting at b, from their colour distance to the
+/// centre (texel units) and the prior's trust; the paper's plane-independent terms are added to
+/// `constant`. Samples from `count` on are padding: weight 0.
+inline void blockWeights(const KernelSelf& s, const KernelWindowOut& out, int b, int count,
+                         __m256 l1, __m256 trust, float& constant) {
+  // w = LUT[min(lut_size - 1, int(l1 * lut_step))] (l1 >= 0), 0 on the padding. Eight scalar
+  // loads, not a gather instruction: with the microcode mitigation of gather data sampling on
+  // current Intel CPUs a gather costs a fifth of the whole window build.
+  const __m256 lut_step = _mm256_set1_ps(s.lut_scale / static_cast<float>(kTexelScale));
+  const __m256 lut_last = _mm256_set1_ps(static_cast<float>(s.lut_size - 1));
+  alignas(32) int lut_index[kSimdBlock];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(lut_index),
+                     _mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(l1, lut_step), lut_last)));
+  const float* lut = s.weight_lut;
+  const __m256 looked_up =
+      _mm256_setr_ps(lut[lut_index[0]], lut[lut_index[1]], lut[lut_index[2]], lut[lut_index[3]],
+                     lut[lut_index[4]], lut[lut_index[5]], lut[lut_index[6]], lut[lut_index[7]]);
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256 valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(count - b), lane));
+  const __m256 w = _mm256_and_ps(valid, looked_up);
+  const __m256 gamma = _mm256_set1_ps(s.gamma);
+  if (s.weighted) {  // phi = (1 - kappa) / (alpha + beta) rho_img + kappa rho_lid
+    const __m256 kappa = _mm256_mul_ps(gamma, trust);
+    _mm256_storeu_ps(out.w_img + b,
+                     _mm256_mul_ps(_mm256_mul_ps(w, _mm256_sub_ps(_mm256_set1_ps(1.f), kappa)),
+                                   _mm256_set1_ps(s.img_norm)));
+    _mm256_storeu_ps(out.w_lidar + b, _mm256_mul_ps(w, kappa));
+    return;
+  }
+  // The paper: phi = rho_img + gamma rho_lid, or + gamma lambda_disp without a prior value.
+  const __m256 has_value = _mm256_cmp_ps(trust, _mm256_setzero_ps(), _CMP_GT_OQ);
+  const __m256 w_gamma = _mm256_mul_ps(w, gamma);
+  _mm256_storeu_ps(out.w_img + b, w);
+  _mm256_storeu_ps(out.w_lidar + b, _mm256_and_ps(has_value, w_gamma));
+  if (s.prior == nullptr) return;
+  alignas(32) float empty_cost[kSimdBlock];
+  _mm256_store_ps(empty_cost, _mm256_andnot_ps(
+                                  has_value, _mm256_mul_ps(w_gamma, _mm256_set1_ps(s.lambda_disp))));
+  for (int j = 0; j < kSimdBlock; ++j) constant += empty_cost[j];  // the scalar code's order
+}
+
+/// The 8 values at `base` + idx[0..7].
+inline __m256 pick8(const float* base, const int* idx) {
+  return _mm256_setr_ps(base[idx[0]], base[idx[1]], base[idx[2]], base[idx[3]], base[idx[4]],
+                        base[idx[5]], base[idx[6]], base[idx[7]]);
+}
+
+/// The window of a pixel whose samples are all inside the image, from the fixed offsets of
+/// KernelSelf's interior window, a block of 8 samples at a time in one pass: the same entries
+/// as gatherSamples and the weights' pass (the padding too: zero texels and priors).
+void interiorWindow(const KernelSelf& s, int px, int py, const KernelWindowOut& out, int count,
+                    int padded, __m256i center, float& constant) {
+  const long centre = static_cast<long>(py) * s.width + px;
+  const short* texels = s.texels + centre * kTexelChannels;
+  const float* prior = s.prior != nullptr ? s.prior + centre : nullptr;
+  const float* trust = s.prior != nullptr ? s.trust + centre : nullptr;
+  const __m256 fx = _mm256_set1_ps(static_cast<float>(px));
+  const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
+  const __m256i row = _mm256_set1_epi32(py * s.other_texel_stride);
+  for (int b = 0; b < padded; b += kSimdBlock) {
+    _mm256_storeu_ps(out.xs + b, _mm256_add_ps(fx, _mm256_loadu_ps(s.interior_dx + b)));
+    _mm256_storeu_ps(out.ys + b, _mm256_add_ps(fy, _mm256_loadu_ps(s.interior_dy + b)));
+    _mm256_storeu_si256(
+        reinterpret_cast<__m256i*>(out.texel_row + b),
+        _mm256_add_epi32(row, _mm256_loadu_si256(
+                                  reinterpret_cast<const __m256i*>(s.interior_row + b))));
+    const int* at = s.interior_texel + b;
+    __m128i* own = reinterpret_cast<__m128i*>(out.texels + b * kTexelChannels);
+    __m256i pairs[kPairs];
+    for (int p = 0; p < kPairs; ++p) {
+      const __m128i lo = _mm_load_si128(reinterpret_cast<const __m128i*>(texels + at[p]));
+      const __m128i hi = _mm_load_si128(reinterpret_cast<const __m128i*>(texels + at[p + kPairs]));
+      _mm_store_si128(own + p, lo);
+      _mm_store_si128(own + p + kPairs, hi);
+      pairs[p] = _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
+    }
+    const __m256 l1 = colourDistance(pairs, realPairs(count, b), center);
+    __m256 trusts = _mm256_setzero_ps();
+    if (prior != nullptr) {
+      const int* pixel = s.interior_pixel + b;
+      _mm256_storeu_ps(out.priors + b, pick8(prior, pixel));
+      trusts = pick8(trust, pixel);
+    } else {
+      _mm256_storeu_ps(out.priors + b, _mm256_setzero_ps());
+    }
+    blockWeights(s, out, b, count, l1, trusts, constant);
+  }
+  for (int j = count; j < padded; ++j) {  // the padding's texel and prior are 0
+    _mm_store_si128(reinterpret_cast<__m128i*>(out.texels + j * kTexelChannels),
+                    _mm_setzero_si128());
+    out.priors[j] = 0.f;
+  }
+}
+
 }  // namespace
 
 int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& out, int& padded,
                     float& constant) {
   const int n = s.offset_count * s.offset_count;
-  const int count = gatherSamples(s, px, py, out, (n + kSimdBlock - 1) / kSimdBlock * kSimdBlock);
-  padded = (count + kSimdBlock - 1) / kSimdBlock * kSimdBlock;
+  const int padded_max = (n + kSimdBlock - 1) / kSimdBlock * kSimdBlock;
   constant = 0.f;
   const __m128i center128 = _mm_load_si128(reinterpret_cast<const __m128i*>(
       s.texels + (static_cast<long>(py) * s.width + px) * kTexelChannels));
   const __m256i center = _mm256_broadcastsi128_si256(center128);
-  const __m256i colour = _mm256_setr_epi16(1, 1, 1, 0, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0);
-  const __m256 lut_step = _mm256_set1_ps(s.lut_scale / static_cast<float>(kTexelScale));
-  const __m256 lut_last = _mm256_set1_ps(static_cast<float>(s.lut_size - 1));
-  const __m256 gamma = _mm256_set1_ps(s.gamma), one = _mm256_set1_ps(1.f);
-  const __m256 img_norm = _mm256_set1_ps(s.img_norm), ldisp = _mm256_set1_ps(s.lambda_disp);
-  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const bool paper_constant = !s.weighted && s.prior != nullptr;
-  alignas(32) float empty_cost[kSimdBlock];
+  const int first = s.offsets[0], last = s.offsets[s.offset_count - 1];
+  if ((s.prior == nullptr || s.interior_pixel != nullptr) && px + first >= 0 &&
+      px + last < s.width && py + first >= 0 && py + last < s.height) {
+    padded = padded_max;
+    interiorWindow(s, px, py, out, n, padded, center, constant);
+    return n;
+  }
+  const int count = gatherSamples(s, px, py, out, padded_max);
+  padded = (count + kSimdBlock - 1) / kSimdBlock * kSimdBlock;
   for (int b = 0; b < padded; b += kSimdBlock) {
-    // The RGB L1 distance to the centre, in texel units (exact integers).
-    __m256i pair_sums[kPairs] = {};
-    forRealPairs(realPairs(count, b), [&](auto pair) {
-      constexpr int p = decltype(pair)::value;
-      const __m256i diff = _mm256_abs_epi16(
-          _mm256_sub_epi16(pairOf(out.texels + b * kTexelChannels, p), center));
-      pair_sums[p] = _mm256_madd_epi16(diff, colour);
-    });
-    __m256 l1, unused;
-    channelSums(pair_sums, l1, unused);
-    // w = LUT[min(lut_size - 1, int(l1 * lut_step))] (l1 >= 0), 0 on the padding. Eight scalar
-    // loads, not a gather instruction: with the microcode mitigation of gather data sampling on
-    // current Intel CPUs a gather costs a fifth of the whole window build.
-    alignas(32) int lut_index[kSimdBlock];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(lut_index),
-                       _mm256_cvttps_epi32(_mm256_min_ps(_mm256_mul_ps(l1, lut_step), lut_last)));
-    const float* lut = s.weight_lut;
-    const __m256 looked_up =
-        _mm256_setr_ps(lut[lut_index[0]], lut[lut_index[1]], lut[lut_index[2]], lut[lut_index[3]],
-                       lut[lut_index[4]], lut[lut_index[5]], lut[lut_index[6]], lut[lut_index[7]]);
-    const __m256 valid =
-        _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(count - b), lane));
-    const __m256 w = _mm256_and_ps(valid, looked_up);
-    const __m256 trust = _mm256_loadu_ps(out.w_lidar + b);
-    if (s.weighted) {  // phi = (1 - kappa) / (alpha + beta) rho_img + kappa rho_lid
-      const __m256 kappa = _mm256_mul_ps(gamma, trust);
-      _mm256_storeu_ps(out.w_img + b,
-                       _mm256_mul_ps(_mm256_mul_ps(w, _mm256_sub_ps(one, kappa)), img_norm));
-      _mm256_storeu_ps(out.w_lidar + b, _mm256_mul_ps(w, kappa));
-      continue;
-    }
-    // The paper: phi = rho_img + gamma rho_lid, or + gamma lambda_disp without a prior value.
-    const __m256 has_value = _mm256_cmp_ps(trust, _mm256_setzero_ps(), _CMP_GT_OQ);
-    const __m256 w_gamma = _mm256_mul_ps(w, gamma);
-    _mm256_storeu_ps(out.w_img + b, w);
-    _mm256_storeu_ps(out.w_lidar + b, _mm256_and_ps(has_value, w_gamma));
-    if (!paper_constant) continue;
-    _mm256_store_ps(empty_cost, _mm256_andnot_ps(has_value, _mm256_mul_ps(w_gamma, ldisp)));
-    for (int j = 0; j < kSimdBlock; ++j) constant += empty_cost[j];  // the scalar code's order
+    __m256i pairs[kPairs];
+    for (int p = 0; p < kPairs; ++p) pairs[p] = pairOf(out.texels + b * kTexelChannels, p);
+    const __m256 l1 = colourDistance(pairs, realPairs(count, b), center);
+    blockWeights(s, out, b, count, l1, _mm256_loadu_ps(out.w_lidar + b), constant);
   }
   return count;
 }

@@ -92,6 +92,9 @@ class MatchingCost {
   const ViewState& other_;
   std::vector<int> offsets_;
   std::vector<float> weight_lut_;
+  /// KernelSelf's interior window: the samples' offsets (cost_kernel.h).
+  std::vector<float> interior_dx_, interior_dy_;
+  std::vector<int> interior_row_, interior_texel_, interior_pixel_;
   float wa_, wb_, wg_, lcol_, lgrad_, ldisp_, outside_cost_, img_norm_;
   bool use_grad_, use_prior_, weighted_;
   bool avx2_;

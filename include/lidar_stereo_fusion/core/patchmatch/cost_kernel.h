@@ -68,6 +68,12 @@ struct KernelSelf {
   float lut_scale;  ///< LUT entries per unit of RGB L1 distance
   bool weighted;  ///< confidence-weighted phi (else the paper's)
   float gamma, img_norm, lambda_disp;
+  /// The samples of a window wholly inside the image, in the window's order and padded to a
+  /// multiple of kSimdBlock with the first sample, as offsets from the centre: dx, dy [px], dy
+  /// times other_texel_stride, the texel's [shorts] and the pixel's (prior and trust; nullptr
+  /// when their row steps are not the width: then every window takes the general path).
+  const float *interior_dx, *interior_dy;
+  const int *interior_row, *interior_texel, *interior_pixel;
 };
 
 /// Where a window is written: WindowCache's arrays, with room for the padding.
