@@ -1,10 +1,12 @@
-// The AVX2 matching-cost kernel against the baseline one and a double-precision reference of the
-// equations in patchmatch/cost.h; whole PatchMatch runs on both paths.
+// The AVX2 and AVX-512 matching-cost kernels against the baseline one and a double-precision
+// reference of the equations in patchmatch/cost.h; whole PatchMatch runs on every path.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
 #include <limits>
 #include <random>
 #include <string>
@@ -36,6 +38,15 @@ class SimdPathGuard {
   if (!lsf::cpuHasAvx2Fma()) {                                                            \
     GTEST_SKIP() << "this CPU (or build) has no AVX2 + FMA: only the baseline path runs"; \
   }
+
+/// The SIMD paths this CPU runs besides the baseline.
+std::vector<lsf::SimdPath> widePaths() {
+  std::vector<lsf::SimdPath> paths;
+  for (const lsf::SimdPath path : {lsf::SimdPath::kAvx2, lsf::SimdPath::kAvx512}) {
+    if (lsf::simdPathSupported(path)) paths.push_back(path);
+  }
+  return paths;
+}
 
 /// Random BGR noise image.
 cv::Mat randomImage(int w, int h, std::mt19937& rng) {
@@ -155,11 +166,14 @@ struct CostCase {
 
 /// Both kernels and the reference on random windows (borders included) and random planes, some
 /// matching outside the other image; then with random bounds (early exit).
-void compareKernels(const CostCase& cc, uint32_t seed) {
+void compareKernels(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int radius = 8,
+                    int stride = 2) {
   SimdPathGuard guard;
   std::mt19937 rng(seed);
   const int w = 97, h = 41;
   lsf::PatchMatchParams p;
+  p.window_radius = radius;
+  p.window_stride = stride;
   p.confidence_weighting = cc.weighted;
   p.window_dyadic = seed % 2 == 0;  // both window patterns
   if (!cc.with_grad) {
@@ -176,7 +190,7 @@ void compareKernels(const CostCase& cc, uint32_t seed) {
   pm::prepareView(right, p, +1.f, rv);
   for (const pm::ViewState* self : {&lv, &rv}) {
     const pm::ViewState& other = self == &lv ? rv : lv;
-    lsf::setSimdPath(lsf::SimdPath::kAvx2);
+    lsf::setSimdPath(wide);
     const pm::MatchingCost fast(p, *self, other);
     lsf::setSimdPath(lsf::SimdPath::kBaseline);
     const pm::MatchingCost base(p, *self, other);
@@ -198,9 +212,11 @@ void compareKernels(const CostCase& cc, uint32_t seed) {
       const float cf = fast.aggregate(fast_cache, plane, inf);
       const float cb = base.aggregate(base_cache, plane, inf);
       const double ref = referenceCost(p, *self, other, px, py, plane);
-      const auto where = ::testing::Message() << "seed " << seed << " pixel " << px << "," << py
-                                              << " plane " << a << " " << b << " " << plane.c;
-      // The AVX2 kernel repeats the baseline's float operations in its order: bit-identical.
+      const auto where = ::testing::Message()
+                         << (wide == lsf::SimdPath::kAvx512 ? "avx512" : "avx2") << " seed " << seed
+                         << " pixel " << px << "," << py << " plane " << a << " " << b << " "
+                         << plane.c;
+      // The wide kernels repeat the baseline's float operations in its order: bit-identical.
       ASSERT_EQ(cf, cb) << where;
       ASSERT_NEAR(cb, ref, 1e-4 * std::max(1e-3, ref)) << where;
       ASSERT_NEAR(cf, ref, 1e-4 * std::max(1e-3, ref)) << where;
@@ -239,32 +255,71 @@ double differingFraction(const cv::Mat1f& a, const cv::Mat1f& b) {
 
 TEST(CostSimd, ReportsTheActivePath) {
   const std::string level = lsf::simdLevel();
-  EXPECT_TRUE(level == "avx2" || level == "baseline") << level;
+  EXPECT_TRUE(level == "avx512" || level == "avx2" || level == "baseline") << level;
+  EXPECT_TRUE(lsf::simdPathSupported(lsf::activeSimdPath())) << level;
+  EXPECT_TRUE(lsf::simdPathSupported(lsf::SimdPath::kBaseline));
   if (!lsf::cpuHasAvx2Fma()) {
     EXPECT_EQ(level, "baseline");
+    EXPECT_FALSE(lsf::cpuHasAvx512()) << "the AVX-512 path needs the AVX2 one's window";
+  }
+  // Unset or "avx512", LSF_SIMD leaves the widest path the CPU runs.
+  const char* env = std::getenv("LSF_SIMD");
+  if (env == nullptr || std::string(env) == "avx512") {
+    EXPECT_EQ(level, lsf::cpuHasAvx512() ? "avx512" : (lsf::cpuHasAvx2Fma() ? "avx2" : "baseline"));
+  }
+  std::printf("[          ] active path %s; AVX2 + FMA %s, AVX-512 %s\n", level.c_str(),
+              lsf::cpuHasAvx2Fma() ? "yes" : "no", lsf::cpuHasAvx512() ? "yes" : "no");
+}
+
+TEST(CostSimd, SelectingAnUnsupportedPathThrows) {
+  SimdPathGuard guard;
+  for (const lsf::SimdPath path : {lsf::SimdPath::kAvx2, lsf::SimdPath::kAvx512}) {
+    if (lsf::simdPathSupported(path)) {
+      EXPECT_NO_THROW(lsf::setSimdPath(path));
+      EXPECT_EQ(lsf::activeSimdPath(), path);
+    } else {
+      EXPECT_THROW(lsf::setSimdPath(path), std::invalid_argument);
+    }
   }
 }
 
 TEST(CostSimd, KernelsAgreeConfidenceWeighted) {
   SKIP_WITHOUT_AVX2();
-  compareKernels({true, true, true}, 1);
+  for (const lsf::SimdPath wide : widePaths()) compareKernels({true, true, true}, 1, wide);
 }
 
 TEST(CostSimd, KernelsAgreePaperCost) {
   SKIP_WITHOUT_AVX2();
-  compareKernels({false, true, true}, 2);
+  for (const lsf::SimdPath wide : widePaths()) compareKernels({false, true, true}, 2, wide);
 }
 
 TEST(CostSimd, KernelsAgreeWithoutPrior) {
   SKIP_WITHOUT_AVX2();
-  compareKernels({true, false, true}, 3);
-  compareKernels({false, false, true}, 4);
+  for (const lsf::SimdPath wide : widePaths()) {
+    compareKernels({true, false, true}, 3, wide);
+    compareKernels({false, false, true}, 4, wide);
+  }
 }
 
 TEST(CostSimd, KernelsAgreeWithoutGradient) {
   SKIP_WITHOUT_AVX2();
-  compareKernels({true, true, false}, 5);
-  compareKernels({false, true, false}, 6);
+  for (const lsf::SimdPath wide : widePaths()) {
+    compareKernels({true, true, false}, 5, wide);
+    compareKernels({false, true, false}, 6, wide);
+  }
+}
+
+TEST(CostSimd, Avx512KernelsAgree) {
+  if (!lsf::cpuHasAvx512()) {
+    GTEST_SKIP() << "this CPU (or build) has no AVX-512: the AVX2 and baseline paths are tested";
+  }
+  // Windows the kernel steps through differently: 7 x 7 and 9 x 9 samples (16 at a time and a
+  // last 8; the other tests), 5 x 5 (the coarsest level's: 16 and 16), 3 x 3 (one step of 16,
+  // 9 of them real), 11 x 11 (the paper's), and border windows of each.
+  compareKernels({true, true, true}, 7, lsf::SimdPath::kAvx512, 2, 1);
+  compareKernels({false, true, true}, 8, lsf::SimdPath::kAvx512, 2, 1);
+  compareKernels({true, true, true}, 9, lsf::SimdPath::kAvx512, 2, 2);
+  compareKernels({true, true, false}, 10, lsf::SimdPath::kAvx512, 5, 1);
 }
 
 TEST(CostSimd, SidesAreTheShiftedPlanesCostsWhereTheOtherViewIsLinear) {
@@ -281,8 +336,8 @@ TEST(CostSimd, SidesAreTheShiftedPlanesCostsWhereTheOtherViewIsLinear) {
   randomPrior(w, h, rng, prior, confidence);
   const lsf::ViewInput left(randomImage(w, h, rng), prior, {}, confidence);
   const lsf::ViewInput right(ramp, prior, {}, confidence);
-  std::vector<lsf::SimdPath> paths{lsf::SimdPath::kBaseline};
-  if (lsf::cpuHasAvx2Fma()) paths.push_back(lsf::SimdPath::kAvx2);
+  std::vector<lsf::SimdPath> paths = widePaths();
+  paths.insert(paths.begin(), lsf::SimdPath::kBaseline);
   for (const lsf::SimdPath path : paths) {
     lsf::setSimdPath(path);
     lsf::PatchMatchParams p;
@@ -327,15 +382,17 @@ TEST(CostSimd, PatchMatchSameOnBothPaths) {
     p.confidence_weighting = weighted;
     p.num_threads = 2;
     const lsf::ViewInput left(s.left, prior, {}, confidence), right(s.right, cv::Mat1f(), {});
-    lsf::setSimdPath(lsf::SimdPath::kAvx2);
-    const auto fast = lsf::PatchMatchStereo(p).compute(left, right);
     lsf::setSimdPath(lsf::SimdPath::kBaseline);
     const auto base = lsf::PatchMatchStereo(p).compute(left, right);
-    const double differ = differingFraction(fast.disparity, base.disparity);
-    std::printf("[          ] confidence_weighting %d: %.4f %% of pixels differ by > 1e-3 px\n",
-                weighted, 100 * differ);
-    EXPECT_LE(differ, 1e-3) << "confidence_weighting " << weighted;
-    EXPECT_EQ(cv::norm(fast.disparity, base.disparity, cv::NORM_INF), 0.0)
-        << "the kernels are bit-identical, so should be the results";
+    for (const lsf::SimdPath wide : widePaths()) {
+      lsf::setSimdPath(wide);
+      const auto fast = lsf::PatchMatchStereo(p).compute(left, right);
+      const double differ = differingFraction(fast.disparity, base.disparity);
+      std::printf("[          ] %s, confidence_weighting %d: %.4f %% of pixels differ by > 1e-3 px\n",
+                  lsf::simdLevel(), weighted, 100 * differ);
+      EXPECT_LE(differ, 1e-3) << lsf::simdLevel() << " confidence_weighting " << weighted;
+      EXPECT_EQ(cv::norm(fast.disparity, base.disparity, cv::NORM_INF), 0.0)
+          << lsf::simdLevel() << ": the kernels are bit-identical, so should be the results";
+    }
   }
 }

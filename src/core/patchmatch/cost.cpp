@@ -67,7 +67,8 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   use_prior_ = wg_ > 0.f && !self_.prior.empty();
   weighted_ = p_.confidence_weighting;
   img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
-  avx2_ = activeSimdPath() == SimdPath::kAvx2;
+  avx2_ = activeSimdPath() != SimdPath::kBaseline;
+  avx512_ = activeSimdPath() == SimdPath::kAvx512;
   // A window wholly inside the image has the same samples at the same offsets for every pixel.
   const int m = static_cast<int>(offsets_.size());
   const int other_stride = kTexelChannels * other_.width;
@@ -176,6 +177,9 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
 }
 
 float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, float bound) const {
+  if (avx512_) {
+    return aggregateAvx512(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, bound);
+  }
   if (avx2_) return aggregateAvx2(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, bound);
   return aggregateImpl(cache, plane, bound);
 }
@@ -184,6 +188,11 @@ void MatchingCost::aggregateSides(const WindowCache& cache, const Plane& plane, 
                                   float& lower, float& upper) const {
   // The match's move by sign h in the fixed point of the interpolation fraction.
   const int shift_q = static_cast<int>(std::lround(self_.match_sign * h * kFracOne));
+  if (avx512_) {
+    aggregateSidesAvx512(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, h, shift_q, lower,
+                         upper);
+    return;
+  }
   if (avx2_) {
     aggregateSidesAvx2(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, h, shift_q, lower,
                        upper);

@@ -124,7 +124,7 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
   for (size_t i = 0; i < lut.size(); ++i) lut[i] = std::exp(-static_cast<float>(i) / delta);
   filled.copyTo(disparity);  // same size: no new allocation
   const int lut_last = static_cast<int>(lut.size()) - 1;
-  const bool avx2 = activeSimdPath() == SimdPath::kAvx2;
+  const bool avx2 = activeSimdPath() != SimdPath::kBaseline;
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
     // At most radius + 1 samples per axis (every second of 2 radius + 1), and the padding.

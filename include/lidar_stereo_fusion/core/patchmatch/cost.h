@@ -53,7 +53,8 @@ std::vector<int> windowOffsets(int radius, int stride, bool dyadic);
 
 class MatchingCost {
  public:
-  /// Uses the AVX2 kernel when activeSimdPath() is kAvx2.
+  /// Uses the AVX2 kernels when activeSimdPath() is kAvx2, and the AVX-512 cost with the AVX2
+  /// window when it is kAvx512.
   MatchingCost(const PatchMatchParams& params, const ViewState& self, const ViewState& other);
 
   /// w(p, p') for an RGB L1 distance [0, 765].
@@ -97,7 +98,8 @@ class MatchingCost {
   std::vector<int> interior_row_, interior_texel_, interior_pixel_;
   float wa_, wb_, wg_, lcol_, lgrad_, ldisp_, outside_cost_, img_norm_;
   bool use_grad_, use_prior_, weighted_;
-  bool avx2_;
+  bool avx2_;    ///< AVX2 kernels (window, and the cost unless avx512_)
+  bool avx512_;  ///< the AVX-512 cost
   KernelConstants kernel_;
   KernelSelf kernel_self_;
 };

@@ -109,5 +109,16 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
 void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b,
                         float c, float h, int shift_q, float& lower, float& upper);
 
+/// True when cost_avx512.cpp was compiled with AVX-512 F, BW, VL and DQ (x86 builds).
+extern const bool kAvx512KernelBuilt;
+
+/// aggregateAvx2 and aggregateSidesAvx2 with AVX-512 (16 samples per step), bit-identical to
+/// them. Call only where the CPU has AVX-512 F, BW, VL, DQ and the operating system keeps the
+/// 512-bit registers (simd.h).
+float aggregateAvx512(const KernelWindow& w, const KernelConstants& k, float a, float b, float c,
+                      float bound);
+void aggregateSidesAvx512(const KernelWindow& w, const KernelConstants& k, float a, float b,
+                          float c, float h, int shift_q, float& lower, float& upper);
+
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion
