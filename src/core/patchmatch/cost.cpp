@@ -16,14 +16,6 @@ float laneSum(const float* l) {
   return ((l[0] + l[4]) + (l[2] + l[6])) + ((l[1] + l[5]) + (l[3] + l[7]));
 }
 
-/// The window as the AVX2 kernels read it.
-KernelWindow kernelWindow(const WindowCache& cache) {
-  return KernelWindow{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
-                      cache.w_lidar.data(),   cache.priors.data(), cache.texels.data()->v,
-                      cache.texel_row.data(), cache.padded,        cache.count,
-                      cache.constant};
-}
-
 }  // namespace
 
 std::vector<int> windowOffsets(int radius, int stride, bool dyadic) {
@@ -133,6 +125,10 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
                               cache.w_lidar.data(),  cache.priors.data(), cache.texels.data()->v,
                               cache.texel_row.data()};
     cache.count = buildWindowAvx2(kernel_self_, px, py, out, cache.padded, cache.constant);
+    cache.kernel = KernelWindow{cache.xs.data(),      cache.ys.data(),     cache.w_img.data(),
+                                cache.w_lidar.data(), cache.priors.data(), cache.texels.data()->v,
+                                cache.texel_row.data(), cache.padded,      cache.count,
+                                cache.constant};
     return;
   }
   cache.constant = 0.f;
@@ -176,25 +172,17 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
   cache.padded = k;
 }
 
-float MatchingCost::aggregate(const WindowCache& cache, const Plane& plane, float bound) const {
-  if (avx512_) {
-    return aggregateAvx512(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, bound);
-  }
-  if (avx2_) return aggregateAvx2(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, bound);
-  return aggregateImpl(cache, plane, bound);
-}
-
 void MatchingCost::aggregateSides(const WindowCache& cache, const Plane& plane, float h,
                                   float& lower, float& upper) const {
   // The match's move by sign h in the fixed point of the interpolation fraction.
   const int shift_q = static_cast<int>(std::lround(self_.match_sign * h * kFracOne));
   if (avx512_) {
-    aggregateSidesAvx512(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, h, shift_q, lower,
+    aggregateSidesAvx512(cache.kernel, kernel_, plane.a, plane.b, plane.c, h, shift_q, lower,
                          upper);
     return;
   }
   if (avx2_) {
-    aggregateSidesAvx2(kernelWindow(cache), kernel_, plane.a, plane.b, plane.c, h, shift_q, lower,
+    aggregateSidesAvx2(cache.kernel, kernel_, plane.a, plane.b, plane.c, h, shift_q, lower,
                        upper);
     return;
   }

@@ -44,6 +44,9 @@ struct WindowCache {
   float constant = 0.f;        ///< sum of the plane-independent terms (paper: empty prior)
   int count = 0;
   int padded = 0;  ///< count rounded up to a multiple of kSimdBlock (AVX2 path)
+  /// The window as the SIMD kernels read it, set by MatchingCost::buildWindow (pointers into the
+  /// arrays above: valid until they are resized or the cache is copied).
+  KernelWindow kernel{};
   void reserve(size_t n);
 };
 
@@ -64,8 +67,12 @@ class MatchingCost {
   void buildWindow(int px, int py, WindowCache& cache) const;
 
   /// C(p, plane) over the cached window. Stops early (returning a value >= bound) once the
-  /// partial sum exceeds `bound`; exact otherwise.
-  float aggregate(const WindowCache& cache, const Plane& plane, float bound) const;
+  /// partial sum exceeds `bound`; exact otherwise. (Inline: called for every candidate plane.)
+  float aggregate(const WindowCache& cache, const Plane& plane, float bound) const {
+    if (avx512_) return aggregateAvx512(cache.kernel, kernel_, plane.a, plane.b, plane.c, bound);
+    if (avx2_) return aggregateAvx2(cache.kernel, kernel_, plane.a, plane.b, plane.c, bound);
+    return aggregateImpl(cache, plane, bound);
+  }
 
   /// The costs of the planes d - h and d + h (plane.c -+ h) for the sub-pixel step, in one pass
   /// over the window: each sample's match is interpolated on the interval of its match under the
