@@ -58,6 +58,9 @@ inline WideMatch matchWide(const KernelWindow& w, const KernelConstants& k, int 
   m.fractions = _mm512_castsi256_si512(_mm512_cvtsepi32_epi16(f32));
   const __m512i row = _mm512_maskz_loadu_epi32(lanes, w.texel_row + s);
   _mm512_store_si512(node, _mm512_add_epi32(row, _mm512_slli_epi32(i0, 3)));
+  // The nodes are read back from memory as scalars: left to itself the compiler extracts them
+  // from the register, two uops each on the port the shuffles need.
+  asm volatile("" : : "r"(node) : "memory");
   return m;
 }
 
