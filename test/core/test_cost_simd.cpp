@@ -15,6 +15,7 @@
 #include "lidar_stereo_fusion/core/patchmatch.h"
 #include "lidar_stereo_fusion/core/patchmatch/cost.h"
 #include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
+#include "lidar_stereo_fusion/core/patchmatch/median_kernel.h"
 #include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/patchmatch/view_state.h"
 #include "test_scenes.h"
@@ -320,6 +321,40 @@ TEST(CostSimd, Avx512KernelsAgree) {
   compareKernels({false, true, true}, 8, lsf::SimdPath::kAvx512, 2, 1);
   compareKernels({true, true, true}, 9, lsf::SimdPath::kAvx512, 2, 2);
   compareKernels({true, true, false}, 10, lsf::SimdPath::kAvx512, 5, 1);
+}
+
+TEST(CostSimd, WeightedMedianKernelsAgree) {
+  SKIP_WITHOUT_AVX2();
+  // Random windows of every size the fill sees (up to 6 x 6 samples, and beyond), with ties and
+  // zero weights: both kernels give the reference's float, the smallest d whose weight summed in
+  // window order over the d's not above it reaches half the total.
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<float> ud(0.5f, 40.f), uw(0.f, 1.f);
+  for (int n = 1; n <= 70; ++n) {
+    for (int rep = 0; rep < 20; ++rep) {
+      const int padded = (n + pm::kMedianLanes - 1) / pm::kMedianLanes * pm::kMedianLanes;
+      std::vector<float> d(padded, std::numeric_limits<float>::max()), w(padded, 0.f);
+      float total = 0.f;
+      for (int i = 0; i < n; ++i) {
+        d[i] = rep % 3 == 0 ? std::round(ud(rng)) : ud(rng);  // ties every third window
+        w[i] = rep % 4 == 0 && i % 3 == 0 ? 0.f : uw(rng);
+        total += w[i];
+      }
+      const float half = 0.5f * total;
+      float expected = std::numeric_limits<float>::max();
+      for (int i = 0; i < n; ++i) {
+        float cumulative = 0.f;
+        for (int j = 0; j < n; ++j) cumulative += d[j] <= d[i] ? w[j] : 0.f;
+        if (cumulative >= half) expected = std::min(expected, d[i]);
+      }
+      const auto where = ::testing::Message() << "n " << n << " window " << rep;
+      ASSERT_EQ(pm::weightedMedianAvx2(d.data(), w.data(), n, padded, half), expected) << where;
+      if (lsf::cpuHasAvx512()) {
+        ASSERT_EQ(pm::weightedMedianAvx512(d.data(), w.data(), n, padded, half), expected)
+            << where;
+      }
+    }
+  }
 }
 
 TEST(CostSimd, SidesAreTheShiftedPlanesCostsWhereTheOtherViewIsLinear) {

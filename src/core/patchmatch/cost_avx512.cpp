@@ -17,8 +17,9 @@
 #include <immintrin.h>
 
 // GCC 12's AVX-512 intrinsics pass an undefined register as the unused merge source, which
-// -Wmaybe-uninitialized reports at -O3 (GCC bug 105593, fixed in GCC 13).
+// -W(maybe-)uninitialized reports at -O3 (GCC bug 105593, fixed in GCC 13).
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 
 namespace lidar_stereo_fusion {
 namespace patchmatch {

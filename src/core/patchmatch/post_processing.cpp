@@ -20,16 +20,17 @@ namespace {
 /// of w[j] over d[j] <= d[i], reaches `half` (half the total weight). Each candidate's sum runs
 /// over every sample in window order, kMedianLanes candidates side by side, without branches:
 /// for the few dozen samples of a window faster than a quickselect, whose branches the data
-/// decide (with AVX2 where the CPU has it: the same floats). The arrays have room for n rounded
+/// decide (with AVX2 or AVX-512 where the CPU has it: the same floats). The arrays have room for n rounded
 /// up to kMedianLanes; the padding is written here.
-float weightedMedian(float* d, float* w, int n, float half, bool avx2) {
+float weightedMedian(float* d, float* w, int n, float half, SimdPath path) {
   const int padded = (n + kMedianLanes - 1) / kMedianLanes * kMedianLanes;
   // Padding: the largest value, and the largest real sample always qualifies (its sum is all).
   for (int i = n; i < padded; ++i) {
     d[i] = std::numeric_limits<float>::max();
     w[i] = 0.f;
   }
-  if (avx2) return weightedMedianAvx2(d, w, n, padded, half);
+  if (path == SimdPath::kAvx512) return weightedMedianAvx512(d, w, n, padded, half);
+  if (path == SimdPath::kAvx2) return weightedMedianAvx2(d, w, n, padded, half);
   float best = std::numeric_limits<float>::max();
   for (int i0 = 0; i0 < padded; i0 += kMedianLanes) {
     const float* candidate = d + i0;
@@ -124,7 +125,7 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
   for (size_t i = 0; i < lut.size(); ++i) lut[i] = std::exp(-static_cast<float>(i) / delta);
   filled.copyTo(disparity);  // same size: no new allocation
   const int lut_last = static_cast<int>(lut.size()) - 1;
-  const bool avx2 = activeSimdPath() != SimdPath::kBaseline;
+  const SimdPath path = activeSimdPath();
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
     // At most radius + 1 samples per axis (every second of 2 radius + 1), and the padding.
@@ -151,7 +152,7 @@ void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float
           total += w;
         }
       }
-      if (n > 0) disparity(y, x) = weightedMedian(ds.data(), ws.data(), n, 0.5f * total, avx2);
+      if (n > 0) disparity(y, x) = weightedMedian(ds.data(), ws.data(), n, 0.5f * total, path);
     }
   }
 }

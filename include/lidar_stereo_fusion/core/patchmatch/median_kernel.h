@@ -1,6 +1,7 @@
-// PatchMatch hole filling: the plain-data interface of the AVX2 weighted-median kernel
-// (median_avx2.cpp), under cost_kernel.h's rules: this header includes nothing, and the kernel
-// runs only where activeSimdPath() is kAvx2 (the kernel is built with cost_avx2.cpp's flags).
+// PatchMatch hole filling: the plain-data interface of the AVX2 and AVX-512 weighted-median
+// kernels (median_avx2.cpp, median_avx512.cpp), under cost_kernel.h's rules: this header includes
+// nothing, and each kernel runs only where activeSimdPath() allows it (each is built with the
+// matching cost kernel's flags).
 #pragma once
 
 namespace lidar_stereo_fusion {
@@ -15,6 +16,10 @@ constexpr int kMedianLanes = 8;
 /// reaches `half`. d and w hold `padded` entries, a multiple of kMedianLanes, the padding with
 /// the largest float and weight 0. Call only when the CPU has AVX2.
 float weightedMedianAvx2(const float* d, const float* w, int n, int padded, float half);
+
+/// weightedMedianAvx2 with AVX-512, 16 candidates per register: the same float. Call only when
+/// the CPU has AVX-512 (simd.h).
+float weightedMedianAvx512(const float* d, const float* w, int n, int padded, float half);
 
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion
