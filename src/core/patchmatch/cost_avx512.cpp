@@ -126,7 +126,8 @@ inline __m512 lidarTerm(__m512 prior, __m512 d, __m512 ldisp) {
   return _mm512_min_ps(_mm512_abs_ps(_mm512_sub_ps(prior, d)), ldisp);
 }
 
-/// ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 + l7)) of the 8 lanes (cost_kernel.h's order).
+/// ((l0 + l4) + (l2 + l6)) + ((l1 + l5) + (l3 + l7)) of the 8 lanes (cost_kernel.h's order), as
+/// cost_avx2.cpp's (files built for different instructions share no inline code: cost_kernel.h).
 inline float laneSum(__m256 v) {
   const __m128 s4 = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
   const __m128 s2 = _mm_add_ps(s4, _mm_movehl_ps(s4, s4));
