@@ -138,20 +138,25 @@ FusionResult FusionPipeline::process(const FusionInput& input) {
   const auto start = Clock::now();
   const Method method = params_.method;
 
-  // Stage 1: projection (left always, for stats and inspection; right only for fused methods).
+  // Stage 1: projection (left always, for stats and inspection; right only for fused methods,
+  // beside the left).
   const auto t = Clock::now();
-  const SparseDisparity left_sparse = projectCloud(input.cloud, input.T_cam_lidar, input.camera,
-                                                   params_.projection, View::kLeft);
+  SparseDisparity left_sparse, right_sparse;
+  const auto project = [&](View view, SparseDisparity& out) {
+    out = projectCloud(input.cloud, input.T_cam_lidar, input.camera, params_.projection, view);
+  };
+  if (isFused(method)) {
+    bothViews(params_.patchmatch.num_threads != 1 ? 2 : 1,
+              [&] { project(View::kLeft, left_sparse); },
+              [&] { project(View::kRight, right_sparse); });
+  } else {
+    project(View::kLeft, left_sparse);
+  }
   if (usesLidar(method) && left_sparse.points_in_image == 0) {
     throw std::invalid_argument(
         "no LiDAR points land in the image (" + std::to_string(input.cloud.size()) +
         " points, " + std::to_string(left_sparse.points_in_front) +
         " in front of the camera): check the cloud and the LiDAR->camera transform");
-  }
-  SparseDisparity right_sparse;
-  if (isFused(method)) {
-    right_sparse = projectCloud(input.cloud, input.T_cam_lidar, input.camera, params_.projection,
-                                View::kRight);
   }
   const double projection_ms = msSince(t);
   FusionResult result = runStages(input.left, input.right, left_sparse, right_sparse, input.camera);
