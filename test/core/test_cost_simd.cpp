@@ -423,7 +423,8 @@ TEST(CostSimd, PatchMatchSameOnBothPaths) {
       lsf::setSimdPath(wide);
       const auto fast = lsf::PatchMatchStereo(p).compute(left, right);
       const double differ = differingFraction(fast.disparity, base.disparity);
-      std::printf("[          ] %s, confidence_weighting %d: %.4f %% of pixels differ by > 1e-3 px\n",
+      std::printf("[          ] %s, confidence_weighting %d: %.4f %% of pixels differ by > 1e-3 "
+                  "px\n",
                   lsf::simdLevel(), weighted, 100 * differ);
       EXPECT_LE(differ, 1e-3) << lsf::simdLevel() << " confidence_weighting " << weighted;
       EXPECT_EQ(cv::norm(fast.disparity, base.disparity, cv::NORM_INF), 0.0)

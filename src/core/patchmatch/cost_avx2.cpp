@@ -262,8 +262,8 @@ inline void blockWeights(const KernelSelf& s, const KernelWindowOut& out, int b,
   _mm256_storeu_ps(out.w_lidar + b, _mm256_and_ps(has_value, w_gamma));
   if (s.prior == nullptr) return;
   alignas(32) float empty_cost[kSimdBlock];
-  _mm256_store_ps(empty_cost, _mm256_andnot_ps(
-                                  has_value, _mm256_mul_ps(w_gamma, _mm256_set1_ps(s.lambda_disp))));
+  const __m256 empty = _mm256_mul_ps(w_gamma, _mm256_set1_ps(s.lambda_disp));
+  _mm256_store_ps(empty_cost, _mm256_andnot_ps(has_value, empty));
   for (int j = 0; j < kSimdBlock; ++j) constant += empty_cost[j];  // the scalar code's order
 }
 

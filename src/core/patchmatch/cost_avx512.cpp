@@ -101,7 +101,8 @@ inline void channelSums(const __m512i* group_sums, __m512& col, __m512& grad) {
     // Per sample: B + G + R in its first 32 bits, gx + gy in its third.
     x[g] = _mm512_add_epi32(group_sums[g], _mm512_srli_epi64(group_sums[g], 32));
   }
-  const __m512i split = _mm512_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28, 2, 6, 10, 14, 18, 22, 26, 30);
+  const __m512i split =
+      _mm512_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28, 2, 6, 10, 14, 18, 22, 26, 30);
   const __m512i low = _mm512_permutex2var_epi32(x[0], split, x[1]);   // col 0..7, grad 0..7
   const __m512i high = _mm512_permutex2var_epi32(x[2], split, x[3]);  // col 8..15, grad 8..15
   col = _mm512_cvtepi32_ps(_mm512_permutex2var_epi32(

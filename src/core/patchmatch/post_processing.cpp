@@ -20,8 +20,8 @@ namespace {
 /// of w[j] over d[j] <= d[i], reaches `half` (half the total weight). Each candidate's sum runs
 /// over every sample in window order, kMedianLanes candidates side by side, without branches:
 /// for the few dozen samples of a window faster than a quickselect, whose branches the data
-/// decide (with AVX2 or AVX-512 where the CPU has it: the same floats). The arrays have room for n rounded
-/// up to kMedianLanes; the padding is written here.
+/// decide (with AVX2 or AVX-512 where the CPU has it: the same floats). The arrays have room
+/// for n rounded up to kMedianLanes; the padding is written here.
 float weightedMedian(float* d, float* w, int n, float half, SimdPath path) {
   const int padded = (n + kMedianLanes - 1) / kMedianLanes * kMedianLanes;
   // Padding: the largest value, and the largest real sample always qualifies (its sum is all).

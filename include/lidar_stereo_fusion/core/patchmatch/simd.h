@@ -1,11 +1,11 @@
 // PatchMatch: which implementation of the matching-cost kernel runs (runtime SIMD dispatch).
 //
 // The binary is built for baseline x86-64; the cost kernel also exists as an AVX2 + FMA version
-// (cost_avx2.cpp, built with -mavx2 -mfma) and an AVX-512 version of its aggregation
-// (cost_avx512.cpp, F + BW + VL + DQ), chosen at run time: the widest the CPU (and the operating
-// system) supports. All paths give bit-identical costs. The environment variable LSF_SIMD
-// (read once, at the first use) caps it: `baseline` or `avx2`; setSimdPath() switches paths
-// in-process (tests, benchmarks).
+// (cost_avx2.cpp, built with -mavx2 -mfma) and AVX-512 versions of its aggregation and of the
+// fill's weighted median (*_avx512.cpp, F + BW + VL + DQ), chosen at run time: the widest the CPU
+// (and the operating system) supports. All paths give bit-identical results. The environment
+// variable LSF_SIMD (read once, at the first use) caps it: `baseline` or `avx2`; setSimdPath()
+// switches paths in-process (tests, benchmarks).
 #pragma once
 
 namespace lidar_stereo_fusion {
