@@ -145,6 +145,20 @@ inline __m256 imageTerm(const KernelConstants& k, __m256 col, __m256 grad, __m25
   return _mm256_blendv_ps(_mm256_set1_ps(k.outside_cost), rho, inside);
 }
 
+/// Entries [from, to) of the window: zero-weight padding at the first sample's position, with a
+/// zero texel, prior and trust (parked in w_lidar).
+void writePadding(const KernelWindowOut& out, int from, int to) {
+  for (int j = from; j < to; ++j) {
+    out.xs[j] = out.xs[0];
+    out.ys[j] = out.ys[0];
+    out.texel_row[j] = out.texel_row[0];
+    _mm_store_si128(reinterpret_cast<__m128i*>(out.texels + j * kTexelChannels),
+                    _mm_setzero_si128());
+    out.priors[j] = 0.f;
+    out.w_lidar[j] = 0.f;
+  }
+}
+
 /// Pass 1 of buildWindowAvx2: positions, texels and priors of the samples inside the image, then
 /// the padding; the trust is parked in w_lidar. Returns the number of real samples. Per row, the
 /// positions are written 8 at a time (the arrays have kSimdBlock entries of room; what a row
@@ -200,15 +214,7 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
     }
     k += m;
   }
-  for (int j = k; j < padded_max; ++j) {  // zero-weight padding at the first sample's position
-    out.xs[j] = out.xs[0];
-    out.ys[j] = out.ys[0];
-    out.texel_row[j] = out.texel_row[0];
-    _mm_store_si128(reinterpret_cast<__m128i*>(out.texels + j * kTexelChannels),
-                    _mm_setzero_si128());
-    out.priors[j] = 0.f;
-    out.w_lidar[j] = 0.f;
-  }
+  writePadding(out, k, padded_max);
   return k;
 }
 
@@ -275,7 +281,7 @@ inline __m256 pick8(const float* base, const int* idx) {
 
 /// The window of a pixel whose samples are all inside the image, from the fixed offsets of
 /// KernelSelf's interior window, a block of 8 samples at a time in one pass: the same entries
-/// as gatherSamples and the weights' pass (the padding too: zero texels and priors).
+/// as gatherSamples and the weights' pass (the padding too, by writePadding).
 void interiorWindow(const KernelSelf& s, int px, int py, const KernelWindowOut& out, int count,
                     int padded, __m256i center, float& constant) {
   const long centre = static_cast<long>(py) * s.width + px;
@@ -313,11 +319,8 @@ void interiorWindow(const KernelSelf& s, int px, int py, const KernelWindowOut& 
     }
     blockWeights(s, out, b, count, l1, trusts, constant);
   }
-  for (int j = count; j < padded; ++j) {  // the padding's texel and prior are 0
-    _mm_store_si128(reinterpret_cast<__m128i*>(out.texels + j * kTexelChannels),
-                    _mm_setzero_si128());
-    out.priors[j] = 0.f;
-  }
+  // The padding's weights are already 0; its texel and prior become 0 too, as gatherSamples'.
+  writePadding(out, count, padded);
 }
 
 }  // namespace
