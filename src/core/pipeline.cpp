@@ -73,6 +73,10 @@ ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
   return v;
 }
 
+/// Threads for the two views' per-view stages (projection, up-sampling): side by side unless the
+/// user asked for one thread.
+int viewThreads(const FusionParams& p) { return p.patchmatch.num_threads != 1 ? 2 : 1; }
+
 }  // namespace
 
 std::string methodName(Method method) {
@@ -146,7 +150,7 @@ FusionResult FusionPipeline::process(const FusionInput& input) {
     out = projectCloud(input.cloud, input.T_cam_lidar, input.camera, params_.projection, view);
   };
   if (isFused(method)) {
-    bothViews(params_.patchmatch.num_threads != 1 ? 2 : 1,
+    bothViews(viewThreads(params_),
               [&] { project(View::kLeft, left_sparse); },
               [&] { project(View::kRight, right_sparse); });
   } else {
@@ -207,7 +211,7 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
     stats.prior_coverage = coverage(result.prior);
   };
   if (fused) {  // the right view's prior is made beside the left's
-    bothViews(params_.patchmatch.num_threads != 1 ? 2 : 1, left_view,
+    bothViews(viewThreads(params_), left_view,
               [&] { right_prior = upsampleView(right_sparse, right_image, params_); });
   } else {
     left_view();
