@@ -3,7 +3,8 @@
 // Subscribes to every output of the fusion in namespace ~ns (default /fusion), so that all of them
 // are computed, ignores ~warmup seconds, then records ~duration seconds of stats and prints:
 // output rate, latency image stamp -> publish (from FusionStats) and image stamp -> receipt here,
-// core processing time, and the frames dropped / unmatched meanwhile. Exits when done.
+// core processing time, the ROS conversions, the rest of the latency (transport and the wait for
+// the worker), and the frames dropped / unmatched meanwhile. Exits when done.
 #include <algorithm>
 #include <cstdio>
 #include <mutex>
@@ -26,6 +27,7 @@ struct Sample {
   double latency_ms;  ///< stamp -> publish, from FusionStats
   double receipt_ms;  ///< stamp -> receipt here
   double total_ms;    ///< core pipeline
+  double conversion_ms;  ///< ROS conversions in and out (not in total_ms)
   uint32_t dropped, unmatched, processed;
 };
 
@@ -59,7 +61,7 @@ int main(int argc, char** argv) {
         }
         samples.push_back({now.toSec(), s->latency_ms,
                            (ros::Time::now() - s->header.stamp).toSec() * 1e3, s->total_ms,
-                           s->dropped_frames, s->unmatched_frames, s->processed_frames});
+                           s->conversion_ms, s->dropped_frames, s->unmatched_frames, s->processed_frames});
       });
   // Keep every output computed.
   std::vector<ros::Subscriber> keep;
@@ -84,28 +86,35 @@ int main(int argc, char** argv) {
     std::printf("measure_fusion: %zu frames in %.0f s: no rate\n", samples.size(), duration);
     return 1;
   }
-  std::vector<double> latency, receipt, total;
+  std::vector<double> latency, receipt, total, conversion, waited;
   for (const auto& s : samples) {
     latency.push_back(s.latency_ms);
     receipt.push_back(s.receipt_ms);
     total.push_back(s.total_ms);
+    conversion.push_back(s.conversion_ms);
+    // The rest of the latency: transport in, the set's wait for the worker, publishing.
+    waited.push_back(s.latency_ms - s.total_ms - s.conversion_ms);
   }
+  const auto mean = [](const std::vector<double>& v) {
+    return std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+  };
   const double span = samples.back().receipt - samples.front().receipt;
   std::printf(
       "measure_fusion: %zu frames in %.1f s -> %.2f Hz sustained output\n"
       "  latency image stamp -> publish [ms]: mean %.0f  median %.0f  p95 %.0f  max %.0f\n"
       "  latency image stamp -> receipt [ms]: mean %.0f  median %.0f  p95 %.0f\n"
-      "  core pipeline [ms]:                  mean %.0f  median %.0f  max %.0f\n"
+      "  core pipeline [ms]:                  mean %.0f  median %.0f  p95 %.0f  max %.0f\n"
+      "  ROS conversions in + out [ms]:       mean %.0f  p95 %.0f\n"
+      "  rest (transport, wait for the worker) [ms]: mean %.0f  p95 %.0f\n"
       "  meanwhile: %u sets dropped (newer one waiting), %u unmatched; %d frames across a time "
       "jump "
       "not counted\n",
       samples.size(), span, (samples.size() - 1) / span,
-      std::accumulate(latency.begin(), latency.end(), 0.0) / latency.size(),
-      percentile(latency, 0.5), percentile(latency, 0.95), percentile(latency, 1.0),
-      std::accumulate(receipt.begin(), receipt.end(), 0.0) / receipt.size(),
-      percentile(receipt, 0.5), percentile(receipt, 0.95),
-      std::accumulate(total.begin(), total.end(), 0.0) / total.size(), percentile(total, 0.5),
-      percentile(total, 1.0), samples.back().dropped - samples.front().dropped,
+      mean(latency), percentile(latency, 0.5), percentile(latency, 0.95),
+      percentile(latency, 1.0), mean(receipt), percentile(receipt, 0.5),
+      percentile(receipt, 0.95), mean(total), percentile(total, 0.5), percentile(total, 0.95),
+      percentile(total, 1.0), mean(conversion), percentile(conversion, 0.95), mean(waited),
+      percentile(waited, 0.95), samples.back().dropped - samples.front().dropped,
       samples.back().unmatched - samples.front().unmatched, skipped);
   return 0;
 }
