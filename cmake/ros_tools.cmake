@@ -22,6 +22,8 @@ set(LSF_ROS_TOOLS autoware_calibration_publisher kitti_calibration_publisher kit
 foreach(tool ${LSF_ROS_TOOLS})
   target_link_libraries(${tool} ${PROJECT_NAME}_calibration_msgs)
 endforeach()
+# The sweep message: conversions::cloudToMsg, the fields of velodyne_pointcloud.
+target_link_libraries(kitti_to_bag ${PROJECT_NAME}_ros)
 
 install(TARGETS ${LSF_ROS_TOOLS} RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 install(FILES launch/calibration_autoware.launch launch/calibration_kitti.launch

@@ -62,6 +62,15 @@ if(TARGET kitti_runner)
     DEPENDS kitti_to_bag ${PROJECT_NAME}_ros)
   target_compile_definitions(test_kitti_bag_rates PRIVATE
     LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
+  # kitti_to_bag --period / --cycles: stamps of the restamped, repeated stream (no ROS master).
+  catkin_add_gtest(test_kitti_to_bag_stream test/ros/test_kitti_to_bag_stream.cpp
+    test/ros/kitti_bag_util.cpp test/ros/run_command.cpp)
+  if(TARGET test_kitti_to_bag_stream)
+    lsf_tools_test_setup(test_kitti_to_bag_stream)
+    add_dependencies(test_kitti_to_bag_stream kitti_to_bag)
+    target_compile_definitions(test_kitti_to_bag_stream PRIVATE
+      LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
+  endif()
   # playback.launch on a KITTI bag: to the end (fusion and RViz stay) and looped (issue 10).
   lsf_add_tools_rostest(test_playback test/ros/playback.test
     SOURCES test/ros/test_playback.cpp test/ros/kitti_bag_util.cpp test/ros/run_command.cpp

@@ -2,7 +2,7 @@
 // of the stereo + LiDAR rig, so that the fusion nodelet can be replayed on real data.
 //
 //   kitti_to_bag --kitti-raw <date>/<drive>_sync --out <file.bag> [--frames N]
-//                [--calib-dir <date>] [--compression none|lz4|bz2]
+//                [--calib-dir <date>] [--compression none|lz4|bz2] [--period S [--cycles N]]
 //
 // Topics (message time = header stamp):
 //   /stereo/left/image_rect_color    sensor_msgs/Image bgr8, frame left_camera_optical_frame
@@ -26,6 +26,11 @@
 // time = (pi - atan2(y, x)) / (2 pi) * (end - start) - (stamp - start), in [-(end - start), 0].
 // Rings are recovered from the sweep storage order (recoverRingsBySweepOrder).
 //
+// --period S restamps the frames as a stream at a fixed period: frame k's images at the first
+// image stamp + k S, each sweep at its own offset from its images. --cycles N writes that stream N
+// times in a row, stamps going on. For rate and latency tests at the sensor's rate on a drive that
+// keeps only some frames (the shared KITTI sample keeps every 5th: 0.5 s apart).
+//
 // Only frames with image_02, image_03, a Velodyne sweep and non-blank image and Velodyne stamps
 // are written (KITTI leaves blank lines for dropped sweeps); the others are listed as skipped.
 // Exit status: 0 written, 1 bad input or write failure, 2 bad command line.
@@ -33,7 +38,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -54,6 +58,7 @@
 
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/ros/calibration_msgs.h"
+#include "lidar_stereo_fusion/ros/conversions.h"
 
 namespace lsf = lidar_stereo_fusion;
 namespace fs = std::filesystem;
@@ -82,15 +87,36 @@ struct Options {
   std::string out;
   std::string calib_dir;  ///< empty = parent of drive_dir
   int max_frames = -1;    ///< -1 = all
+  double period = 0.0;    ///< [s] > 0: restamp the frames at this period
+  int cycles = 1;         ///< times the (restamped) frames are written
   rosbag::CompressionType compression = rosbag::compression::Uncompressed;
 };
 
 const char* usage() {
   return "usage: kitti_to_bag --kitti-raw <date>/<drive>_sync --out <file.bag> [--frames N]\n"
          "                    [--calib-dir <date folder>] [--compression none|lz4|bz2]\n"
+         "                    [--period S [--cycles N]]\n"
          "  Writes the frames that have image_02, image_03 and a Velodyne sweep (the first N with\n"
          "  --frames) as /stereo/{left,right}/{image_rect_color,camera_info}, /velodyne_points\n"
-         "  and /tf_static. --calib-dir defaults to the drive folder's parent.\n";
+         "  and /tf_static. --calib-dir defaults to the drive folder's parent.\n"
+         "  --period S stamps frame k's images at the first image stamp + k S (each sweep keeps\n"
+         "  its offset from its images), and --cycles N writes these frames N times in a row:\n"
+         "  a stream at the sensor's rate from a drive that keeps only some frames.\n";
+}
+
+/// A positive integer option value, or a UsageError naming the option.
+long positiveInteger(const std::string& option, const std::string& value) {
+  size_t used = 0;
+  long n = 0;
+  try {
+    n = std::stol(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != value.size() || n <= 0) {
+    throw UsageError(option + " needs a positive integer, got '" + value + "'");
+  }
+  return n;
 }
 
 Options parseOptions(int argc, char** argv) {
@@ -110,17 +136,19 @@ Options parseOptions(int argc, char** argv) {
     } else if (arg == "--calib-dir") {
       options.calib_dir = value;
     } else if (arg == "--frames") {
+      options.max_frames = static_cast<int>(std::min<long>(positiveInteger(arg, value), 1000000));
+    } else if (arg == "--cycles") {
+      options.cycles = static_cast<int>(std::min<long>(positiveInteger(arg, value), 1000000));
+    } else if (arg == "--period") {
       size_t used = 0;
-      long n = 0;
       try {
-        n = std::stol(value, &used);
+        options.period = std::stod(value, &used);
       } catch (const std::exception&) {
         used = 0;
       }
-      if (used != value.size() || n <= 0) {
-        throw UsageError("--frames needs a positive integer, got '" + value + "'");
+      if (used != value.size() || !(options.period > 0.0 && options.period <= 10.0)) {
+        throw UsageError("--period needs a time in seconds in (0, 10], got '" + value + "'");
       }
-      options.max_frames = static_cast<int>(std::min<long>(n, 1000000));
     } else if (arg == "--compression") {
       if (value == "none") {
         options.compression = rosbag::compression::Uncompressed;
@@ -137,6 +165,9 @@ Options parseOptions(int argc, char** argv) {
   }
   if (options.drive_dir.empty()) throw UsageError("--kitti-raw is required");
   if (options.out.empty()) throw UsageError("--out is required");
+  if (options.cycles > 1 && options.period <= 0.0) {
+    throw UsageError("--cycles needs --period (the stamps of a repeated frame must go on)");
+  }
   if (options.calib_dir.empty())
     options.calib_dir = lsf::kitti::calibrationDirOf(options.drive_dir);
   return options;
@@ -181,44 +212,6 @@ struct FrameToWrite {
   double sweep_period = kDefaultSweepPeriod;       ///< [s] timestamps_end - timestamps_start
   double stamp_after_start = kDefaultSweepPeriod;  ///< [s] from the sweep start to cloud_stamp
 };
-
-/// PointCloud2 with x, y, z, intensity (float32), ring (uint16), time (float32 [s] from the
-/// stamp), 24-byte points (ring padded to 4 bytes so that `time` is aligned).
-sensor_msgs::PointCloud2 cloudMsg(const lsf::LidarCloud& cloud, const std_msgs::Header& header) {
-  sensor_msgs::PointCloud2 msg;
-  msg.header = header;
-  msg.height = 1;
-  msg.width = static_cast<uint32_t>(cloud.size());
-  msg.is_bigendian = false;
-  msg.point_step = 24;
-  msg.row_step = msg.point_step * msg.width;
-  const auto field = [](const std::string& name, uint32_t offset, uint8_t type) {
-    sensor_msgs::PointField f;
-    f.name = name;
-    f.offset = offset;
-    f.datatype = type;
-    f.count = 1;
-    return f;
-  };
-  using sensor_msgs::PointField;
-  msg.fields = {field("x", 0, PointField::FLOAT32),    field("y", 4, PointField::FLOAT32),
-                field("z", 8, PointField::FLOAT32),    field("intensity", 12, PointField::FLOAT32),
-                field("ring", 16, PointField::UINT16), field("time", 20, PointField::FLOAT32)};
-  msg.data.assign(static_cast<size_t>(msg.row_step), 0);
-  bool dense = true;
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    const lsf::LidarPoint& p = cloud[i];
-    uint8_t* out = &msg.data[i * msg.point_step];
-    const float xyzi[4] = {p.x, p.y, p.z, p.intensity};
-    const uint16_t ring = static_cast<uint16_t>(std::clamp(p.ring, 0, 65535));
-    std::memcpy(out, xyzi, sizeof(xyzi));
-    std::memcpy(out + 16, &ring, sizeof(ring));
-    std::memcpy(out + 20, &p.time, sizeof(p.time));
-    dense = dense && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-  }
-  msg.is_dense = dense;
-  return msg;
-}
 
 /// Sets each point's time [s] relative to the cloud stamp from its azimuth.
 void setPointTimes(const FrameToWrite& frame, lsf::LidarCloud& cloud) {
@@ -344,6 +337,30 @@ std::vector<FrameToWrite> selectFrames(const Options& options) {
   return frames;
 }
 
+/// --period / --cycles: the frames as a stream at a fixed period, `cycles` times in a row.
+std::vector<FrameToWrite> restamped(const std::vector<FrameToWrite>& frames,
+                                    const Options& options) {
+  if (options.period <= 0.0) return frames;
+  std::vector<FrameToWrite> stream;
+  const ros::Time first = frames.front().image_stamp;
+  for (int cycle = 0; cycle < options.cycles; ++cycle) {
+    for (const FrameToWrite& frame : frames) {
+      FrameToWrite next = frame;
+      next.image_stamp = first + ros::Duration(options.period * static_cast<double>(stream.size()));
+      next.cloud_stamp = next.image_stamp + (frame.cloud_stamp - frame.image_stamp);
+      if (cycle == 0 &&
+          std::abs((frame.cloud_stamp - frame.image_stamp).toSec()) >= 0.5 * options.period) {
+        std::cerr << "kitti_to_bag: warning: frame " << frame.files.name << ": its sweep is "
+                  << (frame.cloud_stamp - frame.image_stamp).toSec()
+                  << " s from its images, half the --period or more: a consumer may pair it "
+                     "with a neighbouring frame's images\n";
+      }
+      stream.push_back(next);
+    }
+  }
+  return stream;
+}
+
 std::string partialPath(const Options& options) { return options.out + ".partial"; }
 
 void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
@@ -384,7 +401,11 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
     left_info.header = left_header;
     right_info.header = right_header;
     const lsf::kitti::FrameData data = loadFrame(frame, calib.camera);
-    const sensor_msgs::PointCloud2 cloud = cloudMsg(data.cloud, cloud_header);
+    // The fields of velodyne_pointcloud: x, y, z, intensity, ring, time.
+    sensor_msgs::PointCloud2 cloud = lsf::conversions::cloudToMsg(data.cloud, cloud_header);
+    cloud.is_dense = std::all_of(data.cloud.begin(), data.cloud.end(), [](const lsf::LidarPoint& p) {
+      return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+    });
     bag.write(kCloudTopic, frame.cloud_stamp, cloud);
     bag.write(kLeftInfoTopic, frame.image_stamp, left_info);
     bag.write(kLeftImageTopic, frame.image_stamp,
@@ -419,7 +440,7 @@ int main(int argc, char** argv) {
       throw std::runtime_error("KITTI: --kitti-raw " + options.drive_dir + " is not a folder");
     }
     const lsf::kitti::Calibration calib = lsf::kitti::readCalibration(options.calib_dir);
-    const std::vector<FrameToWrite> frames = selectFrames(options);
+    const std::vector<FrameToWrite> frames = restamped(selectFrames(options), options);
     writeBag(options, calib, frames);
     std::cout << "kitti_to_bag: wrote " << frames.size() << " frame(s) to " << options.out << "\n";
   } catch (const rosbag::BagException& e) {

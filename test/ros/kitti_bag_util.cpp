@@ -2,7 +2,10 @@
 
 #include <filesystem>
 
+#include <rosbag/view.h>
+
 #include "data/data_guard.h"
+#include "lidar_stereo_fusion/io/kitti.h"
 
 namespace fs = std::filesystem;
 
@@ -39,6 +42,21 @@ std::string makeSubsetDrive(const std::string& scratch, const std::vector<std::s
     }
   }
   return drive.string();
+}
+
+std::map<std::string, std::vector<rosbag::MessageInstance>> readBag(const std::string& path,
+                                                                    rosbag::Bag& bag) {
+  bag.open(path, rosbag::bagmode::Read);
+  std::map<std::string, std::vector<rosbag::MessageInstance>> by_topic;
+  rosbag::View view(bag);
+  for (const rosbag::MessageInstance& m : view) by_topic[m.getTopic()].push_back(m);
+  return by_topic;
+}
+
+double kittiStamp(const std::string& file, const std::string& frame) {
+  const std::vector<double> stamps = kitti::readTimestamps(file);
+  const size_t index = std::stoul(frame);
+  return index < stamps.size() ? stamps[index] : -1.0;
 }
 
 }  // namespace test

@@ -58,29 +58,14 @@ const std::vector<std::string> kReplayFrames = {"0000000000", "0000000005", "000
 /// two cores; a frame that never comes out fails the test long before rostest's time limit).
 constexpr double kFrameTimeout = 240.0;
 
+using lidar_stereo_fusion::test::kittiStamp;
+using lidar_stereo_fusion::test::readBag;
 using lidar_stereo_fusion::test::runCommand;
 
 std::string scratchDir() { return lidar_stereo_fusion::test::scratchDir("test_kitti_bag"); }
 
 std::string makeSubsetDrive(const std::vector<std::string>& frames) {
   return lidar_stereo_fusion::test::makeSubsetDrive(scratchDir(), frames);
-}
-
-/// Every message of `bag`, grouped by topic, in time order.
-std::map<std::string, std::vector<rosbag::MessageInstance>> readBag(const std::string& path,
-                                                                    rosbag::Bag& bag) {
-  bag.open(path, rosbag::bagmode::Read);
-  std::map<std::string, std::vector<rosbag::MessageInstance>> by_topic;
-  rosbag::View view(bag);
-  for (const rosbag::MessageInstance& m : view) by_topic[m.getTopic()].push_back(m);
-  return by_topic;
-}
-
-/// Stamp [s] of `frame` in a KITTI timestamps file (line = frame number).
-double kittiStamp(const std::string& file, const std::string& frame) {
-  const std::vector<double> stamps = kitti::readTimestamps(file);
-  const size_t index = std::stoul(frame);
-  return index < stamps.size() ? stamps[index] : -1.0;
 }
 
 /// The messages received on the fusion outputs, keyed by header stamp.
