@@ -79,7 +79,8 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
       watch_({topicName(kLeftImage), topicName(kLeftInfo), topicName(kRightImage),
               topicName(kRightInfo), topicName(kCloud)},
              params.input_timeout, log),
-      rate_(params.max_rate) {
+      rate_(params.max_rate),
+      fresh_(params.fresh_wait) {
   InputMatcher::Params mp;
   mp.max_time_offset = params_.max_time_offset;
   mp.max_wait = params_.max_sweep_wait;
@@ -166,6 +167,7 @@ void InputGate::unsubscribe() {
   // Sets in flight when the last subscriber leaves are dropped, and counted.
   const std::size_t pending = matcher_.clear() + (next_ ? 1 : 0);
   next_.reset();
+  fresh_.clear();
   counters_.dropped += static_cast<uint32_t>(pending);
   ROS_DEBUG_STREAM("[" << log_.name() << "] no subscribers left: unsubscribed from the inputs");
 }
@@ -181,14 +183,27 @@ void InputGate::stop() {
 
 boost::optional<InputMatch> InputGate::next(std::chrono::milliseconds timeout) {
   std::unique_lock<std::mutex> lock(mutex_);
+  const bool was_waiting = static_cast<bool>(next_);  // the worker was busy when it came
   ready_cv_.wait_for(lock, timeout, [this] { return stop_ || static_cast<bool>(next_); });
   if (stop_) return boost::none;
   // Image sets that waited max_sweep_wait (ROS time) for a later sweep are decided here.
   InputMatcher::Events events = matcher_.poll(ros::Time::now());
   handleEvents(events, kLeftImage, ros::Time());
+  if (was_waiting && next_) waitForFresher(lock);
+  if (stop_) return boost::none;
   boost::optional<InputMatch> out = std::move(next_);
   next_.reset();
   return out;
+}
+
+void InputGate::waitForFresher(std::unique_lock<std::mutex>& lock) {
+  const boost::optional<ros::Time> until = fresh_.holdUntil(next_ready_, ros::Time::now());
+  if (!until) return;
+  // In slices, as ROS time may be simulated; a newer set (handleEvents) ends the wait at once.
+  const uint64_t seen = ready_count_;
+  while (!stop_ && ready_count_ == seen && ros::Time::now() < *until) {
+    ready_cv_.wait_for(lock, std::chrono::milliseconds(2));
+  }
 }
 
 void InputGate::reject(const Rejection& r, const ros::Time& stamp, const char* what_skipped) {
@@ -284,6 +299,7 @@ void InputGate::handleEvents(InputMatcher::Events& events, const std::string& to
   if (events.restarted) {
     counters_.dropped += static_cast<uint32_t>(events.discarded);
     ++clock_epoch_;
+    fresh_.clear();
     std::ostringstream text;
     text << topicName(topic) << ": stamp " << stampText(stamp) << " is more than "
          << matcher_.params().restart_step
@@ -323,6 +339,9 @@ void InputGate::handleEvents(InputMatcher::Events& events, const std::string& to
   // are dropped and counted, so a slow pipeline never builds a backlog.
   counters_.dropped += static_cast<uint32_t>(events.ready.size() - 1 + (next_ ? 1 : 0));
   next_ = std::move(events.ready.back());
+  next_ready_ = ros::Time::now();
+  fresh_.ready(next_ready_);
+  ++ready_count_;
   ready_cv_.notify_one();
 }
 

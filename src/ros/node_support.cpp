@@ -46,6 +46,9 @@ NodeParams NodeParams::read(const ros::NodeHandle& pnh) {
   readChecked(pnh, "max_output_depth", p.max_output_depth, non_negative, "must be >= 0 [m]");
   readChecked(pnh, "depth_color_max", p.depth_color_max, positive, "must be > 0 [m]");
   readChecked(pnh, "max_rate", p.max_rate, non_negative, "must be >= 0 [Hz] (0 = no limit)");
+  readChecked(
+      pnh, "fresh_wait", p.fresh_wait, [](double v) { return v >= 0.0 && v <= 1.0; },
+      "must be in [0, 1] s (0 = off)");
   readChecked(pnh, "input_timeout", p.input_timeout, non_negative, "must be >= 0 [s] (0 = off)");
   readChecked(
       pnh, "worker_nice", p.worker_nice, [](int v) { return v >= 0 && v <= 19; },

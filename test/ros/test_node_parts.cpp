@@ -8,6 +8,7 @@
 #include <boost/make_shared.hpp>
 
 #include "lidar_stereo_fusion/ros/conversions.h"
+#include "lidar_stereo_fusion/ros/fresh_wait.h"
 #include "lidar_stereo_fusion/ros/input_gate.h"
 #include "lidar_stereo_fusion/ros/input_watch.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
@@ -112,6 +113,64 @@ TEST(InputGate, RateLimiterKeepsOneSetPerPeriod) {
   EXPECT_TRUE(five_hz.accept(ros::Time(50.0))) << "time went back (a bag loop): not throttled";
   lsf::RateLimiter unlimited(0.0);
   for (int i = 0; i < 5; ++i) EXPECT_TRUE(unlimited.accept(ros::Time(100.0 + 0.01 * i)));
+}
+
+namespace {
+
+/// Sets ready at 10 Hz from t = 100 s: `n` of them; returns the last one's time.
+ros::Time readyAt10Hz(lsf::FreshWait& fresh, int n) {
+  ros::Time t;
+  for (int i = 0; i < n; ++i) fresh.ready(t = ros::Time(100.0 + 0.1 * i));
+  return t;
+}
+
+ros::Time after(const ros::Time& t, double s) { return t + ros::Duration(s); }
+
+}  // namespace
+
+// ~fresh_wait: a set that waited for the busy worker is exchanged for the next one only when that
+// is due within the wait; then the worker waits until the due time plus half the wait.
+TEST(FreshWait, HoldsAWaitingSetOnlyWhenTheNextIsDueWithinTheWait) {
+  lsf::FreshWait fresh(0.05);
+  EXPECT_FALSE(fresh.holdUntil(ros::Time(100.0), ros::Time(100.09))) << "no period known yet";
+  ros::Time last = readyAt10Hz(fresh, 3);  // two intervals: not yet a period
+  EXPECT_EQ(fresh.period(), 0.0);
+  EXPECT_FALSE(fresh.holdUntil(last, after(last, 0.09)));
+  last = readyAt10Hz(fresh, 4);
+  EXPECT_NEAR(fresh.period(), 0.1, 1e-9);
+  const auto until = fresh.holdUntil(last, after(last, 0.06));  // next due in 40 ms
+  ASSERT_TRUE(until);
+  EXPECT_NEAR(until->toSec(), after(last, 0.125).toSec(), 1e-9);
+  EXPECT_FALSE(fresh.holdUntil(last, after(last, 0.04))) << "next due in 60 ms";
+  EXPECT_FALSE(fresh.holdUntil(last, last)) << "a fresh set";
+  EXPECT_FALSE(fresh.holdUntil(last, after(last, 0.11))) << "the next is overdue";
+}
+
+TEST(FreshWait, WaitsAtMostHalfThePeriodAndZeroIsOff) {
+  lsf::FreshWait greedy(1.0);
+  ros::Time last = readyAt10Hz(greedy, 6);
+  EXPECT_FALSE(greedy.holdUntil(last, after(last, 0.04)))
+      << "next due in 60 ms: the set is fresher than the average";
+  const auto until = greedy.holdUntil(last, after(last, 0.06));
+  ASSERT_TRUE(until);
+  EXPECT_NEAR(until->toSec(), after(last, 0.125).toSec(), 1e-9);
+  lsf::FreshWait off(0.0);
+  last = readyAt10Hz(off, 6);
+  EXPECT_FALSE(off.holdUntil(last, after(last, 0.09)));
+}
+
+TEST(FreshWait, PeriodIsTheMedianIntervalAndRestartsWhenTimeGoesBack) {
+  lsf::FreshWait fresh(0.05);
+  for (const double t : {100.0, 100.1, 100.2, 100.7, 100.8}) fresh.ready(ros::Time(t));
+  EXPECT_NEAR(fresh.period(), 0.1, 1e-9) << "one dropped sweep does not move the median";
+  fresh.ready(ros::Time(100.8));  // two sets at once: no interval of 0
+  EXPECT_NEAR(fresh.period(), 0.1, 1e-9);
+  fresh.ready(ros::Time(50.0));  // a bag loop
+  EXPECT_EQ(fresh.period(), 0.0);
+  for (int i = 1; i <= static_cast<int>(lsf::FreshWait::kIntervals) + 5; ++i) {
+    fresh.ready(ros::Time(50.0 + 0.2 * i));
+  }
+  EXPECT_NEAR(fresh.period(), 0.2, 1e-9);
 }
 
 TEST(ThrottledLog, OncePerPeriodPerTopicAndKindWithABoundedKeySet) {

@@ -1,7 +1,8 @@
 // The input gate of the live node: subscriptions (made and dropped by the output publisher, which
 // knows when anyone listens), the checks of every message where it enters, ~max_rate, and the
 // pairing of image sets with sweeps in ROS time (FrameMatcher). It hands the newest matched set to
-// the worker and drops (and counts) older ones: never a backlog.
+// the worker and drops (and counts) older ones: never a backlog. A set that waited for the busy
+// worker may be exchanged for the next one if that is due within ~fresh_wait (FreshWait).
 //
 // One lock (mutex_): the matcher, the hand-over slot, the clock and rate state. Subscribing and
 // unsubscribing happen without it (a subscription's shutdown waits for its running callbacks,
@@ -28,6 +29,7 @@
 #include <boost/optional.hpp>
 
 #include "lidar_stereo_fusion/ros/frame_matcher.h"
+#include "lidar_stereo_fusion/ros/fresh_wait.h"
 #include "lidar_stereo_fusion/ros/input_watch.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 
@@ -83,7 +85,8 @@ class InputGate {
   bool subscribed() const { return subscribed_; }
 
   /// The newest matched set, waiting up to `timeout` for one; first decides the sets that waited
-  /// ~max_sweep_wait of ROS time. None on timeout or after stop().
+  /// ~max_sweep_wait of ROS time. A set that was already waiting may be exchanged for the next
+  /// one, if that is due within ~fresh_wait (FreshWait). None on timeout or after stop().
   boost::optional<InputMatch> next(std::chrono::milliseconds timeout);
   void stop();
   bool stopped() const { return stopped_; }
@@ -107,6 +110,7 @@ class InputGate {
   // With mutex_ held:
   void handleEvents(InputMatcher::Events& events, const std::string& topic, const ros::Time& stamp);
   void detectClockJump();
+  void waitForFresher(std::unique_lock<std::mutex>& lock);
   std::string topicName(const std::string& relative) const { return nh_.resolveName(relative); }
 
   ros::NodeHandle nh_, pnh_;
@@ -128,7 +132,10 @@ class InputGate {
   std::condition_variable ready_cv_;
   InputMatcher matcher_;
   boost::optional<InputMatch> next_;
+  ros::Time next_ready_;      ///< ROS time next_ became ready
+  uint64_t ready_count_ = 0;  ///< sets handed to next_ so far
   RateLimiter rate_;
+  FreshWait fresh_;
   ros::Time last_clock_;
   bool stop_ = false;
   std::atomic<bool> stopped_{false};

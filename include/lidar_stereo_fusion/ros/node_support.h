@@ -36,6 +36,10 @@ struct NodeParams {
   /// [Hz] image sets stamped closer than 0.9 / max_rate after the last accepted one are dropped on
   /// arrival, counted (FusionStats.rate_limited) and not warned about. 0 = no limit.
   double max_rate = 0.0;
+  /// [s] when the worker gets free and the next matched set is due within this (at most half the
+  /// input period), it waits for that set and drops the older one: lower latency, a slightly lower
+  /// output rate (FreshWait). 0 = always the newest waiting set at once.
+  double fresh_wait = 0.05;
   /// [s] wall time after which an input topic that sent nothing is warned about, by name (0 = off).
   double input_timeout = 5.0;
   /// Nice increment of the worker thread (and so of the OpenMP threads it starts): the pipeline
