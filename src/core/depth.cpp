@@ -110,14 +110,31 @@ OrganizedCloud makeOrganizedCloud(const cv::Mat1f& depth, const cv::Mat& image,
   OrganizedCloud cloud;
   cloud.width = (depth.cols + stride - 1) / stride;
   cloud.height = (depth.rows + stride - 1) / stride;
-  cloud.points.reserve(static_cast<size_t>(cloud.width) * cloud.height);
+  cloud.points.resize(static_cast<size_t>(cloud.width) * cloud.height);
+  // backProject's arithmetic, written out on row pointers: this runs on every output frame of
+  // the live node (stereo_image_proc's points2 is as large).
   const float nan = std::numeric_limits<float>::quiet_NaN();
+  const bool colour = image.type() == CV_8UC3;
+  ColoredPoint* out = cloud.points.data();
   for (int y = 0; y < depth.rows; y += stride) {
-    for (int x = 0; x < depth.cols; x += stride) {
-      const float z = depth(y, x);
-      ColoredPoint p = backProject(x, y, hasValue(z) ? z : 1.f, image, camera);
-      if (!hasValue(z)) p.x = p.y = p.z = nan;
-      cloud.points.push_back(p);
+    const float* z_row = depth.ptr<float>(y);
+    const uint8_t* pixels = image.ptr<uint8_t>(y);
+    for (int x = 0; x < depth.cols; x += stride, ++out) {
+      const float z = z_row[x];
+      if (hasValue(z)) {
+        out->x = static_cast<float>((x - camera.cx) * z / camera.fx);
+        out->y = static_cast<float>((y - camera.cy) * z / camera.fy);
+        out->z = z;
+      } else {
+        out->x = out->y = out->z = nan;
+      }
+      if (colour) {
+        out->b = pixels[3 * x];
+        out->g = pixels[3 * x + 1];
+        out->r = pixels[3 * x + 2];
+      } else {
+        out->r = out->g = out->b = pixels[x];
+      }
     }
   }
   return cloud;

@@ -460,19 +460,22 @@ sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const OrganizedCloud& cloud,
   msg->height = static_cast<uint32_t>(cloud.height);
   msg->width = static_cast<uint32_t>(cloud.width);
   msg->row_step = msg->width * msg->point_step;
-  sensor_msgs::PointCloud2Iterator<float> x(*msg, "x"), y(*msg, "y"), z(*msg, "z");
-  sensor_msgs::PointCloud2Iterator<uint8_t> rgb(*msg, "rgb");  // bytes b, g, r, a (little endian)
+  // Written directly (16-byte points: x, y, z at 0, 4, 8, then b, g, r, a: the rgb float's bytes in
+  // little endian); the field iterators took 6 ms per KITTI-sized frame.
+  if (msg->point_step != 16 || msg->fields[3].offset != 12) {
+    throw std::logic_error("coloredCloudToMsg: unexpected x, y, z, rgb layout");
+  }
   bool dense = true;
+  uint8_t* out = msg->data.data();
   for (const auto& p : cloud.points) {
-    *x = p.x;
-    *y = p.y;
-    *z = p.z;
-    rgb[0] = p.b;
-    rgb[1] = p.g;
-    rgb[2] = p.r;
-    rgb[3] = 0;
+    const float xyz[3] = {p.x, p.y, p.z};
+    std::memcpy(out, xyz, sizeof(xyz));
+    out[12] = p.b;
+    out[13] = p.g;
+    out[14] = p.r;
+    out[15] = 0;
     dense = dense && std::isfinite(p.z);
-    ++x, ++y, ++z, ++rgb;
+    out += 16;
   }
   msg->is_dense = dense;
   return msg;

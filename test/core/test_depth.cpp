@@ -1,8 +1,11 @@
 // Disparity <-> depth and the coloured cloud on hand-computed examples.
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "lidar_stereo_fusion/core/depth.h"
 
@@ -93,6 +96,58 @@ TEST(ColoredCloud, GreyImagesStrideAndBadInput) {
   EXPECT_THROW(makeColoredCloud(z, grey, camera(4, 4), 0), std::invalid_argument);
   EXPECT_THROW(makeColoredCloud(z, cv::Mat1b(3, 4), camera(4, 4)), std::invalid_argument);
   EXPECT_THROW(makeColoredCloud(z, cv::Mat1f(4, 4), camera(4, 4)), std::invalid_argument);
+}
+
+// The organised cloud (points2) on a grid: every pixel with depth is the same point, to the bit,
+// as the unorganised cloud's; pixels without depth are NaN and keep their colour. BGR and grey,
+// strides that do and do not divide the size.
+TEST(OrganizedCloud, EqualsTheUnorganisedCloudOnTheGridWithNanElsewhere) {
+  cv::Mat1f z(7, 9, 0.f);
+  cv::Mat3b bgr(7, 9);
+  for (int y = 0; y < z.rows; ++y) {
+    for (int x = 0; x < z.cols; ++x) {
+      if ((x * 3 + y) % 4 != 0) z(y, x) = 0.37f * static_cast<float>(1 + x + 2 * y);
+      bgr(y, x) = cv::Vec3b(static_cast<uint8_t>(x), static_cast<uint8_t>(10 + y),
+                            static_cast<uint8_t>(20 + x + y));
+    }
+  }
+  z(3, 4) = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat1b grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  for (const cv::Mat& image : {cv::Mat(bgr), cv::Mat(grey)}) {
+    for (const int stride : {1, 2, 3}) {
+      SCOPED_TRACE("channels " + std::to_string(image.channels()) + ", stride " +
+                   std::to_string(stride));
+      const OrganizedCloud grid = makeOrganizedCloud(z, image, camera(9, 7), stride);
+      const std::vector<ColoredPoint> points = makeColoredCloud(z, image, camera(9, 7), stride);
+      ASSERT_EQ(grid.width, (9 + stride - 1) / stride);
+      ASSERT_EQ(grid.height, (7 + stride - 1) / stride);
+      ASSERT_EQ(grid.points.size(), static_cast<size_t>(grid.width * grid.height));
+      size_t next = 0;
+      for (int v = 0; v < grid.height; ++v) {
+        for (int u = 0; u < grid.width; ++u) {
+          const ColoredPoint& p = grid.points[v * grid.width + u];
+          const int x = u * stride, y = v * stride;
+          const bool has = std::isfinite(z(y, x)) && z(y, x) > 0.f;
+          const uint8_t expected_b = image.channels() == 3 ? bgr(y, x)[0] : grey(y, x);
+          const uint8_t expected_r = image.channels() == 3 ? bgr(y, x)[2] : grey(y, x);
+          EXPECT_EQ(p.b, expected_b) << x << ", " << y;
+          EXPECT_EQ(p.r, expected_r) << x << ", " << y;
+          if (!has) {
+            EXPECT_TRUE(std::isnan(p.x) && std::isnan(p.y) && std::isnan(p.z)) << x << ", " << y;
+            continue;
+          }
+          ASSERT_LT(next, points.size());
+          const ColoredPoint& q = points[next++];
+          EXPECT_EQ(p.x, q.x);
+          EXPECT_EQ(p.y, q.y);
+          EXPECT_EQ(p.z, q.z);
+          EXPECT_EQ(p.g, q.g);
+        }
+      }
+      EXPECT_EQ(next, points.size());
+    }
+  }
 }
 
 }  // namespace
