@@ -2,6 +2,7 @@
 #include "lidar_stereo_fusion/core/depth.h"
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -104,6 +105,37 @@ std::vector<ColoredPoint> makeColoredCloud(const cv::Mat1f& depth, const cv::Mat
   return cloud;
 }
 
+namespace {
+
+/// Calls emit(x, y, z, b, g, r) for each point of the organised grid, row-major: backProject's
+/// arithmetic on row pointers, with x, y, z NaN where the pixel has no depth. One template for
+/// both outputs, which run on every frame of the live node (points2 is as large as
+/// stereo_image_proc's).
+template <class Emit>
+void forEachGridPoint(const cv::Mat1f& depth, const cv::Mat& image, const StereoCamera& camera,
+                      int stride, Emit&& emit) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const bool colour = image.type() == CV_8UC3;
+  for (int y = 0; y < depth.rows; y += stride) {
+    const float* z_row = depth.ptr<float>(y);
+    const uint8_t* pixels = image.ptr<uint8_t>(y);
+    for (int x = 0; x < depth.cols; x += stride) {
+      const float z = z_row[x];
+      const bool has = hasValue(z);
+      const float px = has ? static_cast<float>((x - camera.cx) * z / camera.fx) : nan;
+      const float py = has ? static_cast<float>((y - camera.cy) * z / camera.fy) : nan;
+      const uint8_t* bgr = colour ? pixels + 3 * x : nullptr;
+      if (colour) {
+        emit(px, py, has ? z : nan, bgr[0], bgr[1], bgr[2]);
+      } else {
+        emit(px, py, has ? z : nan, pixels[x], pixels[x], pixels[x]);
+      }
+    }
+  }
+}
+
+}  // namespace
+
 OrganizedCloud makeOrganizedCloud(const cv::Mat1f& depth, const cv::Mat& image,
                                   const StereoCamera& camera, int stride) {
   checkCloudInputs(depth, image, camera, stride, "makeOrganizedCloud");
@@ -111,33 +143,30 @@ OrganizedCloud makeOrganizedCloud(const cv::Mat1f& depth, const cv::Mat& image,
   cloud.width = (depth.cols + stride - 1) / stride;
   cloud.height = (depth.rows + stride - 1) / stride;
   cloud.points.resize(static_cast<size_t>(cloud.width) * cloud.height);
-  // backProject's arithmetic, written out on row pointers: this runs on every output frame of
-  // the live node (stereo_image_proc's points2 is as large).
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const bool colour = image.type() == CV_8UC3;
   ColoredPoint* out = cloud.points.data();
-  for (int y = 0; y < depth.rows; y += stride) {
-    const float* z_row = depth.ptr<float>(y);
-    const uint8_t* pixels = image.ptr<uint8_t>(y);
-    for (int x = 0; x < depth.cols; x += stride, ++out) {
-      const float z = z_row[x];
-      if (hasValue(z)) {
-        out->x = static_cast<float>((x - camera.cx) * z / camera.fx);
-        out->y = static_cast<float>((y - camera.cy) * z / camera.fy);
-        out->z = z;
-      } else {
-        out->x = out->y = out->z = nan;
-      }
-      if (colour) {
-        out->b = pixels[3 * x];
-        out->g = pixels[3 * x + 1];
-        out->r = pixels[3 * x + 2];
-      } else {
-        out->r = out->g = out->b = pixels[x];
-      }
-    }
-  }
+  forEachGridPoint(depth, image, camera, stride,
+                   [&](float x, float y, float z, uint8_t b, uint8_t g, uint8_t r) {
+                     *out++ = ColoredPoint{x, y, z, r, g, b};
+                   });
   return cloud;
+}
+
+bool packOrganizedCloud(const cv::Mat1f& depth, const cv::Mat& image, const StereoCamera& camera,
+                        int stride, uint8_t* out) {
+  checkCloudInputs(depth, image, camera, stride, "packOrganizedCloud");
+  bool dense = true;
+  forEachGridPoint(depth, image, camera, stride,
+                   [&](float x, float y, float z, uint8_t b, uint8_t g, uint8_t r) {
+                     const float xyz[3] = {x, y, z};
+                     std::memcpy(out, xyz, sizeof(xyz));
+                     out[12] = b;
+                     out[13] = g;
+                     out[14] = r;
+                     out[15] = 0;
+                     out += kPackedPointBytes;
+                     dense = dense && !std::isnan(z);
+                   });
+  return dense;
 }
 
 }  // namespace lidar_stereo_fusion

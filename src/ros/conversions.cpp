@@ -448,36 +448,28 @@ sensor_msgs::ImagePtr floatImageToMsg(const cv::Mat1f& image, const std_msgs::He
   return boost::make_shared<sensor_msgs::Image>(floatImage(image, header));
 }
 
-sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const OrganizedCloud& cloud,
-                                              const std_msgs::Header& header) {
+sensor_msgs::PointCloud2Ptr organizedCloudToMsg(const cv::Mat1f& depth, const cv::Mat& image,
+                                                const StereoCamera& camera, int stride,
+                                                const std_msgs::Header& header) {
+  if (stride < 1) throw std::invalid_argument("organizedCloudToMsg: stride must be >= 1");
   auto msg = boost::make_shared<sensor_msgs::PointCloud2>();
   msg->header = header;
   sensor_msgs::PointCloud2Modifier modifier(*msg);
   modifier.setPointCloud2Fields(4, "x", 1, PointField::FLOAT32, "y", 1, PointField::FLOAT32, "z", 1,
                                 PointField::FLOAT32, "rgb", 1, PointField::FLOAT32);
+  if (msg->point_step != kPackedPointBytes) {  // packOrganizedCloud's layout is the modifier's
+    throw std::logic_error("organizedCloudToMsg: x, y, z, rgb take " +
+                           std::to_string(msg->point_step) + " bytes, not " +
+                           std::to_string(kPackedPointBytes));
+  }
+  const uint32_t width = static_cast<uint32_t>((depth.cols + stride - 1) / stride);
+  const uint32_t height = static_cast<uint32_t>((depth.rows + stride - 1) / stride);
   // resize(w * h) makes it 1 x N; the organised shape is set after.
-  modifier.resize(cloud.points.size());
-  msg->height = static_cast<uint32_t>(cloud.height);
-  msg->width = static_cast<uint32_t>(cloud.width);
+  modifier.resize(static_cast<size_t>(width) * height);
+  msg->height = height;
+  msg->width = width;
   msg->row_step = msg->width * msg->point_step;
-  // Written directly (16-byte points: x, y, z at 0, 4, 8, then b, g, r, a: the rgb float's bytes in
-  // little endian); the field iterators took 6 ms per KITTI-sized frame.
-  if (msg->point_step != 16 || msg->fields[3].offset != 12) {
-    throw std::logic_error("coloredCloudToMsg: unexpected x, y, z, rgb layout");
-  }
-  bool dense = true;
-  uint8_t* out = msg->data.data();
-  for (const auto& p : cloud.points) {
-    const float xyz[3] = {p.x, p.y, p.z};
-    std::memcpy(out, xyz, sizeof(xyz));
-    out[12] = p.b;
-    out[13] = p.g;
-    out[14] = p.r;
-    out[15] = 0;
-    dense = dense && std::isfinite(p.z);
-    out += 16;
-  }
-  msg->is_dense = dense;
+  msg->is_dense = packOrganizedCloud(depth, image, camera, stride, msg->data.data());
   return msg;
 }
 

@@ -1,5 +1,6 @@
 // Disparity <-> depth and the coloured cloud on hand-computed examples.
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -99,8 +100,8 @@ TEST(ColoredCloud, GreyImagesStrideAndBadInput) {
 }
 
 // The organised cloud (points2) on a grid: every pixel with depth is the same point, to the bit,
-// as the unorganised cloud's; pixels without depth are NaN and keep their colour. BGR and grey,
-// strides that do and do not divide the size.
+// as the unorganised cloud's; pixels without depth are NaN and keep their colour; the packed form
+// holds the same bytes. BGR and grey, strides that do and do not divide the size.
 TEST(OrganizedCloud, EqualsTheUnorganisedCloudOnTheGridWithNanElsewhere) {
   cv::Mat1f z(7, 9, 0.f);
   cv::Mat3b bgr(7, 9);
@@ -120,6 +121,8 @@ TEST(OrganizedCloud, EqualsTheUnorganisedCloudOnTheGridWithNanElsewhere) {
                    std::to_string(stride));
       const OrganizedCloud grid = makeOrganizedCloud(z, image, camera(9, 7), stride);
       const std::vector<ColoredPoint> points = makeColoredCloud(z, image, camera(9, 7), stride);
+      std::vector<uint8_t> packed(grid.points.size() * kPackedPointBytes, 0xAB);
+      EXPECT_FALSE(packOrganizedCloud(z, image, camera(9, 7), stride, packed.data()));
       ASSERT_EQ(grid.width, (9 + stride - 1) / stride);
       ASSERT_EQ(grid.height, (7 + stride - 1) / stride);
       ASSERT_EQ(grid.points.size(), static_cast<size_t>(grid.width * grid.height));
@@ -128,6 +131,13 @@ TEST(OrganizedCloud, EqualsTheUnorganisedCloudOnTheGridWithNanElsewhere) {
         for (int u = 0; u < grid.width; ++u) {
           const ColoredPoint& p = grid.points[v * grid.width + u];
           const int x = u * stride, y = v * stride;
+          // The packed point: the same floats (NaN too, to the bit) and b, g, r, 0.
+          const uint8_t* packed_point = packed.data() + (v * grid.width + u) * kPackedPointBytes;
+          EXPECT_EQ(std::memcmp(packed_point, &p, 3 * sizeof(float)), 0) << x << ", " << y;
+          EXPECT_EQ(packed_point[12], p.b);
+          EXPECT_EQ(packed_point[13], p.g);
+          EXPECT_EQ(packed_point[14], p.r);
+          EXPECT_EQ(packed_point[15], 0);
           const bool has = std::isfinite(z(y, x)) && z(y, x) > 0.f;
           const uint8_t expected_b = image.channels() == 3 ? bgr(y, x)[0] : grey(y, x);
           const uint8_t expected_r = image.channels() == 3 ? bgr(y, x)[2] : grey(y, x);

@@ -368,19 +368,26 @@ TEST(Conversions, DisparityImageLikeStereoImageProc) {
 }
 
 TEST(Conversions, ColouredCloudPacksRgbLikePcl) {
-  lsf::OrganizedCloud points;
-  points.width = 1;
-  points.height = 1;
-  points.points = {{1.f, 2.f, 3.f, 200, 100, 50}};
-  std_msgs::Header header;
-  const auto msg = conv::coloredCloudToMsg(points, header);
+  lsf::StereoCamera camera;
+  camera.fx = camera.fy = 100;
+  camera.cx = 2;
+  camera.cy = 1;
+  camera.baseline = 0.5;
+  camera.width = camera.height = 1;
+  const cv::Mat1f depth(1, 1, 3.f);
+  const cv::Mat3b image(1, 1, cv::Vec3b(50, 100, 200));  // B, G, R
+  const auto msg = conv::organizedCloudToMsg(depth, image, camera, 1, std_msgs::Header());
   EXPECT_TRUE(msg->is_dense);
   sensor_msgs::PointCloud2ConstIterator<uint8_t> r(*msg, "r"), g(*msg, "g"), b(*msg, "b");
   EXPECT_EQ(*r, 200);
   EXPECT_EQ(*g, 100);
   EXPECT_EQ(*b, 50);
-  sensor_msgs::PointCloud2ConstIterator<float> z(*msg, "z");
+  sensor_msgs::PointCloud2ConstIterator<float> x(*msg, "x"), y(*msg, "y"), z(*msg, "z");
+  EXPECT_FLOAT_EQ(*x, -2 * 3.f / 100);
+  EXPECT_FLOAT_EQ(*y, -1 * 3.f / 100);
   EXPECT_FLOAT_EQ(*z, 3.f);
+  EXPECT_THROW(conv::organizedCloudToMsg(depth, image, camera, 0, std_msgs::Header()),
+               std::invalid_argument);
 }
 
 TEST(Conversions, OrganisedCloudKeepsTheGridWithNanForNoValue) {
@@ -394,8 +401,7 @@ TEST(Conversions, OrganisedCloudKeepsTheGridWithNanForNoValue) {
   cv::Mat1f depth(3, 4, 0.f);
   depth(2, 3) = 10.f;
   const cv::Mat3b image(3, 4, cv::Vec3b(1, 2, 3));
-  const auto msg =
-      conv::coloredCloudToMsg(lsf::makeOrganizedCloud(depth, image, camera), std_msgs::Header());
+  const auto msg = conv::organizedCloudToMsg(depth, image, camera, 1, std_msgs::Header());
   EXPECT_EQ(msg->height, 3u);
   EXPECT_EQ(msg->width, 4u);
   EXPECT_EQ(msg->row_step, 4u * msg->point_step);
@@ -408,9 +414,10 @@ TEST(Conversions, OrganisedCloudKeepsTheGridWithNanForNoValue) {
       EXPECT_TRUE(std::isnan(*z)) << i;
     }
   }
-  const auto strided = lsf::makeOrganizedCloud(depth, image, camera, 2);
-  EXPECT_EQ(strided.width, 2);
-  EXPECT_EQ(strided.height, 2);
+  const auto strided = conv::organizedCloudToMsg(depth, image, camera, 2, std_msgs::Header());
+  EXPECT_EQ(strided->width, 2u);
+  EXPECT_EQ(strided->height, 2u);
+  EXPECT_EQ(strided->data.size(), 4u * strided->point_step);
 }
 
 // --- sweep matching ------------------------------------------------------------------------------

@@ -1,6 +1,7 @@
 // Stage 4: disparity -> depth and the coloured point cloud in the left optical frame.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -42,5 +43,16 @@ struct OrganizedCloud {
 /// Throws like makeColoredCloud.
 OrganizedCloud makeOrganizedCloud(const cv::Mat1f& depth, const cv::Mat& image,
                                   const StereoCamera& camera, int stride = 1);
+
+/// Bytes of a point packed by packOrganizedCloud.
+constexpr int kPackedPointBytes = 16;
+
+/// makeOrganizedCloud's points packed straight into `out` (ceil(H / stride) * ceil(W / stride) *
+/// kPackedPointBytes bytes, row-major), as sensor_msgs/PointCloud2 data with the fields x, y, z,
+/// rgb of PCL's PointXYZRGB: float x, y, z at bytes 0, 4, 8, then the bytes b, g, r, 0 of the rgb
+/// float (little endian). Without the intermediate cloud: one pass over 7 MB less per KITTI frame.
+/// Returns true when every point has depth (is_dense). Throws like makeOrganizedCloud.
+bool packOrganizedCloud(const cv::Mat1f& depth, const cv::Mat& image, const StereoCamera& camera,
+                        int stride, uint8_t* out);
 
 }  // namespace lidar_stereo_fusion

@@ -102,12 +102,15 @@ sensor_msgs::ImagePtr bgrImageToMsg(const cv::Mat& image, const std_msgs::Header
 /// A float map as a 32FC1 image, unchanged (e.g. the LiDAR prior: disparity [px], 0 = empty).
 sensor_msgs::ImagePtr floatImageToMsg(const cv::Mat1f& image, const std_msgs::Header& header);
 
-/// Coloured points (left optical frame [m]) as PointCloud2 with float32 x, y, z and rgb packed as
+/// The coloured points of `depth` [m] and the left `image` (makeOrganizedCloud: left optical
+/// frame, every `stride`-th row and column) as PointCloud2 with float32 x, y, z and rgb packed as
 /// in PCL / depth_image_proc (0x00RRGGBB in the bytes of a float32). Organised (height x width as
 /// the grid, point (u, v) at row v, column u) like stereo_image_proc's points2; NaN x, y, z = no
-/// value, so is_dense is false unless every point has one.
-sensor_msgs::PointCloud2Ptr coloredCloudToMsg(const OrganizedCloud& cloud,
-                                              const std_msgs::Header& header);
+/// value, so is_dense is false unless every point has one. Written in one pass
+/// (packOrganizedCloud). Throws like makeOrganizedCloud.
+sensor_msgs::PointCloud2Ptr organizedCloudToMsg(const cv::Mat1f& depth, const cv::Mat& image,
+                                                const StereoCamera& camera, int stride,
+                                                const std_msgs::Header& header);
 
 }  // namespace conversions
 }  // namespace lidar_stereo_fusion
