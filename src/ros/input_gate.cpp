@@ -197,11 +197,17 @@ boost::optional<InputMatch> InputGate::next(std::chrono::milliseconds timeout) {
 }
 
 void InputGate::waitForFresher(std::unique_lock<std::mutex>& lock) {
-  const boost::optional<ros::Time> until = fresh_.holdUntil(next_ready_, ros::Time::now());
+  const ros::Time now = ros::Time::now();
+  const boost::optional<ros::Time> until = fresh_.holdUntil(next_ready_, now);
   if (!until) return;
   // In slices, as ROS time may be simulated; a newer set (handleEvents) ends the wait at once.
+  // Twice the wait in wall time at most: a paused or slowed bag does not hold the set.
+  const auto wall_limit = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(2.0 * (*until - now).toSec()));
   const uint64_t seen = ready_count_;
-  while (!stop_ && ready_count_ == seen && ros::Time::now() < *until) {
+  while (!stop_ && ready_count_ == seen && ros::Time::now() < *until &&
+         std::chrono::steady_clock::now() < wall_limit) {
     ready_cv_.wait_for(lock, std::chrono::milliseconds(2));
   }
 }

@@ -9,7 +9,8 @@
 // the same under `rosbag play --clock` at any rate). At most half of it is waited for: waiting
 // longer than that would hold sets that are fresher than the average. If the next set does not
 // come by its due time plus half the wait (a dropped sweep, the sensor stopped), the held set is
-// processed after all. Header-only, no I/O, unit-tested.
+// processed after all; InputGate also ends the wait after twice its length in wall time (a paused
+// bag). Header-only, no I/O, unit-tested.
 #pragma once
 
 #include <algorithm>
