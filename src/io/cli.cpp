@@ -2,6 +2,8 @@
 #include "lidar_stereo_fusion/io/cli.h"
 
 #include <climits>
+#include <cmath>
+#include <sstream>
 
 namespace lidar_stereo_fusion {
 
@@ -30,21 +32,47 @@ std::string CommandLine::value(const std::string& name, const std::string& fallb
   return it == values_.end() ? fallback : it->second;
 }
 
+namespace {
+
+/// Whether `parse` (std::stol, std::stod) reads all of `text`; the number goes to `out`.
+template <class T, class Parse>
+bool readWhole(const std::string& text, Parse parse, T& out) {
+  size_t used = 0;
+  try {
+    out = parse(text, &used);
+  } catch (const std::exception&) {
+    return false;
+  }
+  return used != 0 && used == text.size();
+}
+
+}  // namespace
+
 int CommandLine::intValue(const std::string& name, int fallback, int min, int max) const {
   const auto it = values_.find(name);
   if (it == values_.end()) return fallback;
   long parsed = 0;
-  size_t used = 0;
-  try {
-    parsed = std::stol(it->second, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != it->second.size() || parsed < min || parsed > max) {
+  const auto parse = [](const std::string& t, size_t* used) { return std::stol(t, used); };
+  if (!readWhole(it->second, parse, parsed) || parsed < min || parsed > max) {
     throw UsageError(name + " must be an integer in [" + std::to_string(min) + ", " +
                      std::to_string(max) + "], got '" + it->second + "'");
   }
   return static_cast<int>(parsed);
+}
+
+double CommandLine::doubleValue(const std::string& name, double fallback, double min,
+                                double max) const {
+  const auto it = values_.find(name);
+  if (it == values_.end()) return fallback;
+  double parsed = 0.0;
+  const auto parse = [](const std::string& t, size_t* used) { return std::stod(t, used); };
+  if (!readWhole(it->second, parse, parsed) || !std::isfinite(parsed) || parsed < min ||
+      parsed > max) {
+    std::ostringstream range;
+    range << "[" << min << ", " << max << "]";
+    throw UsageError(name + " must be a number in " + range.str() + ", got '" + it->second + "'");
+  }
+  return parsed;
 }
 
 std::string CommandLine::choice(const std::string& name, const std::string& fallback,

@@ -56,6 +56,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <boost/make_shared.hpp>
 
+#include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/ros/calibration_msgs.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
@@ -76,11 +77,6 @@ constexpr char kCloudTopic[] = "/velodyne_points";
 constexpr char kTfStaticTopic[] = "/tf_static";
 constexpr double kDefaultSweepPeriod = 0.1;  ///< HDL-64E at 10 Hz [s], when start/end are absent
 constexpr size_t kHdl64Rings = 64;
-
-/// Thrown for command-line mistakes (exit status 2).
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 struct Options {
   std::string drive_dir;
@@ -104,69 +100,30 @@ const char* usage() {
          "  a stream at the sensor's rate from a drive that keeps only some frames.\n";
 }
 
-/// A positive integer option value, or a UsageError naming the option.
-long positiveInteger(const std::string& option, const std::string& value) {
-  size_t used = 0;
-  long n = 0;
-  try {
-    n = std::stol(value, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != value.size() || n <= 0) {
-    throw UsageError(option + " needs a positive integer, got '" + value + "'");
-  }
-  return n;
-}
-
 Options parseOptions(int argc, char** argv) {
-  Options options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "-h" || arg == "--help") {
-      std::cout << usage();
-      std::exit(0);
-    }
-    if (i + 1 >= argc) throw UsageError("option " + arg + " needs a value");
-    const std::string value = argv[++i];
-    if (arg == "--kitti-raw") {
-      options.drive_dir = value;
-    } else if (arg == "--out") {
-      options.out = value;
-    } else if (arg == "--calib-dir") {
-      options.calib_dir = value;
-    } else if (arg == "--frames") {
-      options.max_frames = static_cast<int>(std::min<long>(positiveInteger(arg, value), 1000000));
-    } else if (arg == "--cycles") {
-      options.cycles = static_cast<int>(std::min<long>(positiveInteger(arg, value), 1000000));
-    } else if (arg == "--period") {
-      size_t used = 0;
-      try {
-        options.period = std::stod(value, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != value.size() || !(options.period > 0.0 && options.period <= 10.0)) {
-        throw UsageError("--period needs a time in seconds in (0, 10], got '" + value + "'");
-      }
-    } else if (arg == "--compression") {
-      if (value == "none") {
-        options.compression = rosbag::compression::Uncompressed;
-      } else if (value == "lz4") {
-        options.compression = rosbag::compression::LZ4;
-      } else if (value == "bz2") {
-        options.compression = rosbag::compression::BZ2;
-      } else {
-        throw UsageError("--compression must be none, lz4 or bz2, got '" + value + "'");
-      }
-    } else {
-      throw UsageError("unknown option " + arg);
-    }
+  const lsf::CommandLine cl(argc, argv,
+                            {"--kitti-raw", "--out", "--calib-dir", "--frames", "--compression",
+                             "--period", "--cycles"},
+                            {"-h", "--help"});
+  if (cl.has("-h") || cl.has("--help")) {
+    std::cout << usage();
+    std::exit(0);
   }
-  if (options.drive_dir.empty()) throw UsageError("--kitti-raw is required");
-  if (options.out.empty()) throw UsageError("--out is required");
+  Options options;
+  options.drive_dir = cl.value("--kitti-raw");
+  options.out = cl.value("--out");
+  options.calib_dir = cl.value("--calib-dir");
+  options.max_frames = cl.intValue("--frames", -1, 1, 1000000);
+  options.period = cl.doubleValue("--period", 0.0, 0.001, 10.0);  // 0: not restamped
+  options.cycles = cl.intValue("--cycles", 1, 1, 1000000);
+  const std::string compression = cl.choice("--compression", "none", {"none", "lz4", "bz2"});
+  options.compression = compression == "lz4"   ? rosbag::compression::LZ4
+                        : compression == "bz2" ? rosbag::compression::BZ2
+                                               : rosbag::compression::Uncompressed;
+  if (options.drive_dir.empty()) throw lsf::UsageError("--kitti-raw is required");
+  if (options.out.empty()) throw lsf::UsageError("--out is required");
   if (options.cycles > 1 && options.period <= 0.0) {
-    throw UsageError("--cycles needs --period (the stamps of a repeated frame must go on)");
+    throw lsf::UsageError("--cycles needs --period (the stamps of a repeated frame must go on)");
   }
   if (options.calib_dir.empty())
     options.calib_dir = lsf::kitti::calibrationDirOf(options.drive_dir);
@@ -431,7 +388,7 @@ int main(int argc, char** argv) {
   Options options;
   try {
     options = parseOptions(argc, argv);
-  } catch (const UsageError& e) {
+  } catch (const lsf::UsageError& e) {
     std::cerr << "kitti_to_bag: " << e.what() << "\n" << usage();
     return 2;
   }

@@ -250,5 +250,27 @@ TEST(CommandLine, OptionsFlagsAndErrors) {
   EXPECT_THROW(CommandLine(3, junk, {"--frames"}, {}).intValue("--frames", 0, 0, 9), UsageError);
 }
 
+TEST(CommandLine, NumbersInARange) {
+  const char* argv[] = {"tool", "--period", "0.1", "--scale", "2e1"};
+  const CommandLine cl(5, argv, {"--period", "--scale", "--rate"}, {});
+  EXPECT_EQ(cl.doubleValue("--period", 0.0, 0.001, 10.0), 0.1);
+  EXPECT_EQ(cl.doubleValue("--scale", 0.0, 0.0, 100.0), 20.0);
+  EXPECT_EQ(cl.doubleValue("--rate", 7.5, 0.0, 1.0), 7.5) << "absent: the fallback, unchecked";
+  EXPECT_THROW(cl.doubleValue("--scale", 0.0, 0.0, 10.0), UsageError);
+  for (const char* bad : {"0.1s", "nan", "inf", "", "-", "0x"}) {
+    const char* junk[] = {"tool", "--period", bad};
+    EXPECT_THROW(CommandLine(3, junk, {"--period"}, {}).doubleValue("--period", 0.0, -1e9, 1e9),
+                 UsageError)
+        << bad;
+  }
+  try {
+    const char* low[] = {"tool", "--period", "0"};
+    CommandLine(3, low, {"--period"}, {}).doubleValue("--period", 0.0, 0.001, 10.0);
+    ADD_FAILURE() << "0 is below the range";
+  } catch (const UsageError& e) {
+    EXPECT_EQ(std::string(e.what()), "--period must be a number in [0.001, 10], got '0'");
+  }
+}
+
 }  // namespace
 }  // namespace lidar_stereo_fusion

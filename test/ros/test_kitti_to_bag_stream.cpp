@@ -94,12 +94,13 @@ TEST(KittiToBagStream, BadPeriodOrCyclesAreUsageErrors) {
       std::string(LSF_KITTI_TO_BAG) + " --kitti-raw x --out " + bag_path + " ";
   for (const auto& [args, named] : std::vector<std::pair<std::string, std::string>>{
            {"--cycles 2", "--cycles needs --period"},
-           {"--period 0", "--period needs a time"},
-           {"--period -0.1", "--period needs a time"},
-           {"--period 0.1s", "--period needs a time"},
-           {"--period 11", "--period needs a time"},
-           {"--period nan", "--period needs a time"},
-           {"--period 0.1 --cycles 0", "--cycles needs a positive integer"}}) {
+           {"--period 0", "--period must be a number in"},
+           {"--period -0.1", "--period must be a number in"},
+           {"--period 0.1s", "--period must be a number in"},
+           {"--period 11", "--period must be a number in"},
+           {"--period nan", "--period must be a number in"},
+           {"--period 0.1 --cycles 0", "--cycles must be an integer in"},
+           {"--period 0.1 --period 0.2", "--period given twice"}}) {
     SCOPED_TRACE(args);
     const auto [status, output] = lt::runCommand(command + args);
     EXPECT_EQ(status, 2) << output;

@@ -1,4 +1,5 @@
-// A small command-line parser shared by the tools (kitti_runner, fusion_benchmark). ROS-free.
+// A small command-line parser shared by the tools (kitti_runner, fusion_benchmark, kitti_to_bag,
+// ...). ROS-free.
 #pragma once
 
 #include <map>
@@ -28,6 +29,8 @@ class CommandLine {
   std::string value(const std::string& name, const std::string& fallback = "") const;
   /// The option's value as an integer in [min, max]; UsageError naming the option otherwise.
   int intValue(const std::string& name, int fallback, int min, int max) const;
+  /// The option's value as a finite number in [min, max]; UsageError naming the option otherwise.
+  double doubleValue(const std::string& name, double fallback, double min, double max) const;
   /// The option's value, which must be one of `choices`.
   std::string choice(const std::string& name, const std::string& fallback,
                      const std::vector<std::string>& choices) const;
