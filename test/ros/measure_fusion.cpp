@@ -1,10 +1,11 @@
 // measure_fusion: end-to-end latency and sustained output rate of a running fusion nodelet.
 //
 // Subscribes to every output of the fusion in namespace ~ns (default /fusion), so that all of them
-// are computed, ignores ~warmup seconds, then records ~duration seconds of stats and prints:
-// output rate, latency image stamp -> publish (from FusionStats) and image stamp -> receipt here,
-// core processing time, the ROS conversions, the rest of the latency (transport and the wait for
-// the worker), and the frames dropped / unmatched meanwhile. Exits when done.
+// are computed (~outputs "all"), or only to depth/image_rect and its camera_info, as a consumer of
+// depth would (~outputs "depth"). Ignores ~warmup seconds, then records ~duration seconds of stats
+// and prints: output rate, latency image stamp -> publish (from FusionStats) and image stamp ->
+// receipt here, core processing time, the ROS conversions, the rest of the latency (transport and
+// the wait for the worker), and the frames dropped / unmatched meanwhile. Exits when done.
 #include <algorithm>
 #include <cstdio>
 #include <mutex>
@@ -63,17 +64,27 @@ int main(int argc, char** argv) {
                            (ros::Time::now() - s->header.stamp).toSec() * 1e3, s->total_ms,
                            s->conversion_ms, s->dropped_frames, s->unmatched_frames, s->processed_frames});
       });
-  // Keep every output computed.
+  // Keep the outputs computed: every one (~outputs "all"), or a consumer's (e.g. "depth").
+  const std::string outputs = pnh.param<std::string>("outputs", "all");
+  if (outputs != "all" && outputs != "depth") {
+    std::fprintf(stderr, "measure_fusion: ~outputs must be all or depth, got '%s'\n",
+                 outputs.c_str());
+    return 2;
+  }
   std::vector<ros::Subscriber> keep;
-  keep.push_back(nh.subscribe<stereo_msgs::DisparityImage>(
-      ns + "/disparity", 1, +[](const stereo_msgs::DisparityImageConstPtr&) {}));
   keep.push_back(nh.subscribe<sensor_msgs::CameraInfo>(
       ns + "/depth/camera_info", 1, +[](const sensor_msgs::CameraInfoConstPtr&) {}));
-  keep.push_back(nh.subscribe<sensor_msgs::PointCloud2>(
-      ns + "/points2", 1, +[](const sensor_msgs::PointCloud2ConstPtr&) {}));
-  for (const char* image : {"/depth/image_rect", "/lidar_disparity", "/disparity_image"}) {
-    keep.push_back(nh.subscribe<sensor_msgs::Image>(
-        ns + image, 1, +[](const sensor_msgs::ImageConstPtr&) {}));
+  keep.push_back(nh.subscribe<sensor_msgs::Image>(
+      ns + "/depth/image_rect", 1, +[](const sensor_msgs::ImageConstPtr&) {}));
+  if (outputs == "all") {
+    keep.push_back(nh.subscribe<stereo_msgs::DisparityImage>(
+        ns + "/disparity", 1, +[](const stereo_msgs::DisparityImageConstPtr&) {}));
+    keep.push_back(nh.subscribe<sensor_msgs::PointCloud2>(
+        ns + "/points2", 1, +[](const sensor_msgs::PointCloud2ConstPtr&) {}));
+    for (const char* image : {"/lidar_disparity", "/disparity_image"}) {
+      keep.push_back(nh.subscribe<sensor_msgs::Image>(
+          ns + image, 1, +[](const sensor_msgs::ImageConstPtr&) {}));
+    }
   }
 
   ros::AsyncSpinner spinner(2);
