@@ -124,8 +124,8 @@ void forEachGridPoint(const cv::Mat1f& depth, const cv::Mat& image, const Stereo
       const bool has = hasValue(z);
       const float px = has ? static_cast<float>((x - camera.cx) * z / camera.fx) : nan;
       const float py = has ? static_cast<float>((y - camera.cy) * z / camera.fy) : nan;
-      const uint8_t* bgr = colour ? pixels + 3 * x : nullptr;
       if (colour) {
+        const uint8_t* bgr = pixels + 3 * x;
         emit(px, py, has ? z : nan, bgr[0], bgr[1], bgr[2]);
       } else {
         emit(px, py, has ? z : nan, pixels[x], pixels[x], pixels[x]);
