@@ -73,44 +73,10 @@ void checkCloudInputs(const cv::Mat1f& depth, const cv::Mat& image, const Stereo
   if (stride < 1) throw std::invalid_argument(std::string(what) + ": stride must be >= 1");
 }
 
-/// The point of pixel (x, y) at depth z (not checked), coloured from `image`.
-ColoredPoint backProject(int x, int y, float z, const cv::Mat& image, const StereoCamera& camera) {
-  ColoredPoint p;
-  p.x = static_cast<float>((x - camera.cx) * z / camera.fx);
-  p.y = static_cast<float>((y - camera.cy) * z / camera.fy);
-  p.z = z;
-  if (image.type() == CV_8UC3) {
-    const cv::Vec3b bgr = image.at<cv::Vec3b>(y, x);
-    p.b = bgr[0];
-    p.g = bgr[1];
-    p.r = bgr[2];
-  } else {
-    p.r = p.g = p.b = image.at<uint8_t>(y, x);
-  }
-  return p;
-}
-
-}  // namespace
-
-std::vector<ColoredPoint> makeColoredCloud(const cv::Mat1f& depth, const cv::Mat& image,
-                                           const StereoCamera& camera, int stride) {
-  checkCloudInputs(depth, image, camera, stride, "makeColoredCloud");
-  std::vector<ColoredPoint> cloud;
-  for (int y = 0; y < depth.rows; y += stride) {
-    for (int x = 0; x < depth.cols; x += stride) {
-      const float z = depth(y, x);
-      if (hasValue(z)) cloud.push_back(backProject(x, y, z, image, camera));
-    }
-  }
-  return cloud;
-}
-
-namespace {
-
-/// Calls emit(x, y, z, b, g, r) for each point of the organised grid, row-major: backProject's
-/// arithmetic on row pointers, with x, y, z NaN where the pixel has no depth. One template for
-/// both outputs, which run on every frame of the live node (points2 is as large as
-/// stereo_image_proc's).
+/// Calls emit(x, y, z, b, g, r) for each point of the grid (every `stride`-th row and column),
+/// row-major: X = (x - cx) z / fx, Y = (y - cy) z / fy on row pointers, with x, y, z NaN where the
+/// pixel has no depth. One walker for the three clouds; the organised ones run on every frame of
+/// the live node (points2 is as large as stereo_image_proc's).
 template <class Emit>
 void forEachGridPoint(const cv::Mat1f& depth, const cv::Mat& image, const StereoCamera& camera,
                       int stride, Emit&& emit) {
@@ -135,6 +101,17 @@ void forEachGridPoint(const cv::Mat1f& depth, const cv::Mat& image, const Stereo
 }
 
 }  // namespace
+
+std::vector<ColoredPoint> makeColoredCloud(const cv::Mat1f& depth, const cv::Mat& image,
+                                           const StereoCamera& camera, int stride) {
+  checkCloudInputs(depth, image, camera, stride, "makeColoredCloud");
+  std::vector<ColoredPoint> cloud;
+  forEachGridPoint(depth, image, camera, stride,
+                   [&](float x, float y, float z, uint8_t b, uint8_t g, uint8_t r) {
+                     if (!std::isnan(z)) cloud.push_back(ColoredPoint{x, y, z, r, g, b});
+                   });
+  return cloud;
+}
 
 OrganizedCloud makeOrganizedCloud(const cv::Mat1f& depth, const cv::Mat& image,
                                   const StereoCamera& camera, int stride) {
