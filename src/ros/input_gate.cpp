@@ -198,7 +198,7 @@ boost::optional<InputMatch> InputGate::next(std::chrono::milliseconds timeout) {
 
 void InputGate::waitForFresher(std::unique_lock<std::mutex>& lock) {
   const ros::Time now = ros::Time::now();
-  const boost::optional<ros::Time> until = fresh_.holdUntil(next_ready_, now);
+  const boost::optional<ros::Time> until = fresh_.holdUntil(now);
   if (!until) return;
   // In slices, as ROS time may be simulated; a newer set (handleEvents) ends the wait at once.
   // Twice the wait in wall time at most: a paused or slowed bag does not hold the set.
@@ -345,8 +345,7 @@ void InputGate::handleEvents(InputMatcher::Events& events, const std::string& to
   // are dropped and counted, so a slow pipeline never builds a backlog.
   counters_.dropped += static_cast<uint32_t>(events.ready.size() - 1 + (next_ ? 1 : 0));
   next_ = std::move(events.ready.back());
-  next_ready_ = ros::Time::now();
-  fresh_.ready(next_ready_);
+  fresh_.ready(ros::Time::now());
   ++ready_count_;
   ready_cv_.notify_one();
 }

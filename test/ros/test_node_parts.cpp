@@ -132,31 +132,31 @@ ros::Time after(const ros::Time& t, double s) { return t + ros::Duration(s); }
 // is due within the wait; then the worker waits until the due time plus half the wait.
 TEST(FreshWait, HoldsAWaitingSetOnlyWhenTheNextIsDueWithinTheWait) {
   lsf::FreshWait fresh(0.05);
-  EXPECT_FALSE(fresh.holdUntil(ros::Time(100.0), ros::Time(100.09))) << "no period known yet";
+  EXPECT_FALSE(fresh.holdUntil(ros::Time(100.09))) << "no period known yet";
   ros::Time last = readyAt10Hz(fresh, 3);  // two intervals: not yet a period
   EXPECT_EQ(fresh.period(), 0.0);
-  EXPECT_FALSE(fresh.holdUntil(last, after(last, 0.09)));
+  EXPECT_FALSE(fresh.holdUntil(after(last, 0.09)));
   last = readyAt10Hz(fresh, 4);
   EXPECT_NEAR(fresh.period(), 0.1, 1e-9);
-  const auto until = fresh.holdUntil(last, after(last, 0.06));  // next due in 40 ms
+  const auto until = fresh.holdUntil(after(last, 0.06));  // next due in 40 ms
   ASSERT_TRUE(until);
   EXPECT_NEAR(until->toSec(), after(last, 0.125).toSec(), 1e-9);
-  EXPECT_FALSE(fresh.holdUntil(last, after(last, 0.04))) << "next due in 60 ms";
-  EXPECT_FALSE(fresh.holdUntil(last, last)) << "a fresh set";
-  EXPECT_FALSE(fresh.holdUntil(last, after(last, 0.11))) << "the next is overdue";
+  EXPECT_FALSE(fresh.holdUntil(after(last, 0.04))) << "next due in 60 ms";
+  EXPECT_FALSE(fresh.holdUntil(last)) << "a fresh set";
+  EXPECT_FALSE(fresh.holdUntil(after(last, 0.11))) << "the next is overdue";
 }
 
 TEST(FreshWait, WaitsAtMostHalfThePeriodAndZeroIsOff) {
   lsf::FreshWait greedy(1.0);
   ros::Time last = readyAt10Hz(greedy, 6);
-  EXPECT_FALSE(greedy.holdUntil(last, after(last, 0.04)))
+  EXPECT_FALSE(greedy.holdUntil(after(last, 0.04)))
       << "next due in 60 ms: the set is fresher than the average";
-  const auto until = greedy.holdUntil(last, after(last, 0.06));
+  const auto until = greedy.holdUntil(after(last, 0.06));
   ASSERT_TRUE(until);
   EXPECT_NEAR(until->toSec(), after(last, 0.125).toSec(), 1e-9);
   lsf::FreshWait off(0.0);
   last = readyAt10Hz(off, 6);
-  EXPECT_FALSE(off.holdUntil(last, after(last, 0.09)));
+  EXPECT_FALSE(off.holdUntil(after(last, 0.09)));
 }
 
 TEST(FreshWait, PeriodIsTheMedianIntervalAndRestartsWhenTimeGoesBack) {

@@ -55,13 +55,13 @@ class FreshWait {
     return sorted[sorted.size() / 2];
   }
 
-  /// The worker is free at `now` and the newest set became ready at `ready`: the ROS time until
+  /// The worker is free at `now` with the newest set, the last one ready(): the ROS time until
   /// which to wait for the next one, or none to take this one now.
-  boost::optional<ros::Time> holdUntil(const ros::Time& ready, const ros::Time& now) const {
+  boost::optional<ros::Time> holdUntil(const ros::Time& now) const {
     const double period = this->period();
     const double wait = std::min(max_wait_, 0.5 * period);
     if (wait <= 0.0) return boost::none;
-    const ros::Time due = ready + ros::Duration(period);
+    const ros::Time due = last_ + ros::Duration(period);
     if (due <= now || (due - now).toSec() > wait) return boost::none;
     return due + ros::Duration(0.5 * wait);
   }

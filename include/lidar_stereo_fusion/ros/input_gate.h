@@ -132,7 +132,6 @@ class InputGate {
   std::condition_variable ready_cv_;
   InputMatcher matcher_;
   boost::optional<InputMatch> next_;
-  ros::Time next_ready_;      ///< ROS time next_ became ready
   uint64_t ready_count_ = 0;  ///< sets handed to next_ so far
   RateLimiter rate_;
   FreshWait fresh_;
