@@ -302,13 +302,13 @@ std::vector<FrameToWrite> restamped(const std::vector<FrameToWrite>& frames,
   const ros::Time first = frames.front().image_stamp;
   for (int cycle = 0; cycle < options.cycles; ++cycle) {
     for (const FrameToWrite& frame : frames) {
+      const ros::Duration sweep_offset = frame.cloud_stamp - frame.image_stamp;
       FrameToWrite next = frame;
       next.image_stamp = first + ros::Duration(options.period * static_cast<double>(stream.size()));
-      next.cloud_stamp = next.image_stamp + (frame.cloud_stamp - frame.image_stamp);
-      if (cycle == 0 &&
-          std::abs((frame.cloud_stamp - frame.image_stamp).toSec()) >= 0.5 * options.period) {
+      next.cloud_stamp = next.image_stamp + sweep_offset;
+      if (cycle == 0 && std::abs(sweep_offset.toSec()) >= 0.5 * options.period) {
         std::cerr << "kitti_to_bag: warning: frame " << frame.files.name << ": its sweep is "
-                  << (frame.cloud_stamp - frame.image_stamp).toSec()
+                  << sweep_offset.toSec()
                   << " s from its images, half the --period or more: a consumer may pair it "
                      "with a neighbouring frame's images\n";
       }
@@ -360,9 +360,10 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
     const lsf::kitti::FrameData data = loadFrame(frame, calib.camera);
     // The fields of velodyne_pointcloud: x, y, z, intensity, ring, time.
     sensor_msgs::PointCloud2 cloud = lsf::conversions::cloudToMsg(data.cloud, cloud_header);
-    cloud.is_dense = std::all_of(data.cloud.begin(), data.cloud.end(), [](const lsf::LidarPoint& p) {
-      return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-    });
+    cloud.is_dense =
+        std::all_of(data.cloud.begin(), data.cloud.end(), [](const lsf::LidarPoint& p) {
+          return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+        });
     bag.write(kCloudTopic, frame.cloud_stamp, cloud);
     bag.write(kLeftInfoTopic, frame.image_stamp, left_info);
     bag.write(kLeftImageTopic, frame.image_stamp,

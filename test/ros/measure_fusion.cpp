@@ -62,7 +62,8 @@ int main(int argc, char** argv) {
         }
         samples.push_back({now.toSec(), s->latency_ms,
                            (ros::Time::now() - s->header.stamp).toSec() * 1e3, s->total_ms,
-                           s->conversion_ms, s->dropped_frames, s->unmatched_frames, s->processed_frames});
+                           s->conversion_ms, s->dropped_frames, s->unmatched_frames,
+                           s->processed_frames});
       });
   // Keep the outputs computed: every one (~outputs "all"), or a consumer's (e.g. "depth").
   const std::string outputs = pnh.param<std::string>("outputs", "all");
