@@ -110,6 +110,7 @@ PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
   base.window_radius = 17;
   base.window_stride = 3;
   base.window_dyadic = false;
+  base.window_round = false;
   base.median_radius = 17;
   base.iterations = 3;  // Bleyer's
   base.right_iterations = -1;

@@ -24,6 +24,7 @@ inline lidar_stereo_fusion::PatchMatchParams params3x3() {
   lidar_stereo_fusion::PatchMatchParams p;  // defaults: alpha 0.01, beta 0.09, gamma 0.9, weighted
   p.window_radius = 1;
   p.window_stride = 1;
+  p.window_round = false;  // the whole 3x3 square: 9 samples
   p.coarse_scale = 1;
   return p;
 }

@@ -86,6 +86,13 @@ bool usedOffset(const lsf::PatchMatchParams& p, int o) {
   return !p.window_dyadic || k == 0 || (k & (k - 1)) == 0;
 }
 
+/// Whether the window uses the sample (dx, dy): both offsets used, and in a round window within
+/// the radius of the centre.
+bool usedSample(const lsf::PatchMatchParams& p, int dx, int dy) {
+  if (!usedOffset(p, dx) || !usedOffset(p, dy)) return false;
+  return !p.window_round || dx * dx + dy * dy <= p.window_radius * p.window_radius;
+}
+
 double referenceCost(const lsf::PatchMatchParams& p, const pm::ViewState& self,
                      const pm::ViewState& other, int px, int py, const pm::Plane& plane) {
   const bool use_prior = p.gamma > 0 && !self.prior.empty();
@@ -98,7 +105,7 @@ double referenceCost(const lsf::PatchMatchParams& p, const pm::ViewState& self,
   for (int dy = -p.window_radius; dy <= p.window_radius; ++dy) {
     for (int dx = -p.window_radius; dx <= p.window_radius; ++dx) {
       const int x = px + dx, y = py + dy;
-      if (!usedOffset(p, dy) || !usedOffset(p, dx)) continue;
+      if (!usedSample(p, dx, dy)) continue;
       if (x < 0 || y < 0 || x >= self.width || y >= self.height) continue;
       double l1 = 0;
       for (int i = 0; i < 3; ++i) l1 += std::abs(colour(x, y, i) - colour(px, py, i));
@@ -166,9 +173,9 @@ struct CostCase {
 };
 
 /// Both kernels and the reference on random windows (borders included) and random planes, some
-/// matching outside the other image; then with random bounds (early exit).
-void compareKernels(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int radius = 8,
-                    int stride = 2) {
+/// matching outside the other image; then with random bounds (early exit). Square or round.
+void compareShape(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int radius, int stride,
+                  bool round) {
   SimdPathGuard guard;
   std::mt19937 rng(seed);
   const int w = 97, h = 41;
@@ -177,6 +184,7 @@ void compareKernels(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int r
   p.window_stride = stride;
   p.confidence_weighting = cc.weighted;
   p.window_dyadic = seed % 2 == 0;  // both window patterns
+  p.window_round = round;
   if (!cc.with_grad) {
     p.alpha = 0.1;
     p.beta = 0.0;
@@ -215,6 +223,7 @@ void compareKernels(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int r
       const double ref = referenceCost(p, *self, other, px, py, plane);
       const auto where = ::testing::Message()
                          << (wide == lsf::SimdPath::kAvx512 ? "avx512" : "avx2") << " seed " << seed
+                         << (round ? " round" : " square")
                          << " pixel " << px << "," << py << " plane " << a << " " << b << " "
                          << plane.c;
       // The wide kernels repeat the baseline's float operations in its order: bit-identical.
@@ -241,6 +250,12 @@ void compareKernels(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int r
       }
     }
   }
+}
+
+/// compareShape on the square and on the round window.
+void compareKernels(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int radius = 8,
+                    int stride = 2) {
+  for (const bool round : {false, true}) compareShape(cc, seed, wide, radius, stride, round);
 }
 
 /// Fraction of pixels where two disparity maps differ by more than 1e-3 px.
@@ -315,9 +330,10 @@ TEST(CostSimd, Avx512KernelsAgree) {
     GTEST_SKIP() << "this CPU (or build) has no AVX-512: the AVX2 and baseline paths are tested";
   }
   // Windows the kernel steps through differently: 7 x 7 and 9 x 9 samples (16 at a time and a
-  // last 8; the other tests), 5 x 5 (the coarsest level's: 16 and 16), 3 x 3 (one step of 16,
-  // 9 of them real), 11 x 11 (the paper's; an odd seed is not dyadic), and border windows of
-  // each.
+  // last 8; the other tests), 5 x 5 (16 and 16), 3 x 3 (one step of 16, 9 of them real), 11 x 11
+  // (the paper's; an odd seed is not dyadic), and border windows of each; round, the 7 x 7's 29
+  // samples (16 and 16), the 5 x 5's 13 (the coarsest level's: one step), the 3 x 3's 5 and the
+  // 11 x 11's 81.
   compareKernels({true, true, true}, 7, lsf::SimdPath::kAvx512, 2, 1);
   compareKernels({false, true, true}, 8, lsf::SimdPath::kAvx512, 2, 1);
   compareKernels({true, true, true}, 9, lsf::SimdPath::kAvx512, 2, 2);

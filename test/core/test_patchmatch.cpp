@@ -72,24 +72,36 @@ TEST(PatchMatch, SmoothingKeepsHalfPixelDisparitiesFromLockingToWholePixels) {
 }
 
 TEST(PatchMatch, RecoversSlantedPlane) {
-  const uint64_t seed = 11;
-  // d = 0.08 x + 0.05 y + 6: a ground-like slant in both directions.
-  const PlaneScene s = PlaneScene::make(240, 120, 0.08, 0.05, 6.0, seed);
-  lsf::PatchMatchStereo pm(stereoOnly());
-  const auto r = pm.compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}});
-  EXPECT_LT(meanError(r.disparity, s, 8), 0.05) << "seed " << seed;
-  // The recovered planes carry the slant, not only the disparity: median slopes over the interior.
-  std::vector<float> as, bs;
-  for (int y = 10; y < 110; ++y) {
-    for (int x = 40; x < 230; ++x) {
-      as.push_back(r.planes(y, x)[0]);
-      bs.push_back(r.planes(y, x)[1]);
+  // d = 0.08 x + 0.05 y + 6: a ground-like slant in both directions, on 8 random textures (one
+  // texture's median slope moves by up to 0.007 with the random search: 3 of 12 seeds fail a
+  // 0.005 bound with the square window, 5 with the round one, while the mean over seeds stays
+  // within 0.003 for both).
+  constexpr int kSeeds = 8;
+  double error = 0, mean_a = 0, mean_b = 0;
+  for (uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    const PlaneScene s = PlaneScene::make(240, 120, 0.08, 0.05, 6.0, seed);
+    lsf::PatchMatchStereo pm(stereoOnly());
+    const auto r = pm.compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}});
+    error += meanError(r.disparity, s, 8) / kSeeds;
+    // The recovered planes carry the slant, not only the disparity: median slopes over the
+    // interior.
+    std::vector<float> as, bs;
+    for (int y = 10; y < 110; ++y) {
+      for (int x = 40; x < 230; ++x) {
+        as.push_back(r.planes(y, x)[0]);
+        bs.push_back(r.planes(y, x)[1]);
+      }
     }
+    std::nth_element(as.begin(), as.begin() + as.size() / 2, as.end());
+    std::nth_element(bs.begin(), bs.begin() + bs.size() / 2, bs.end());
+    EXPECT_NEAR(as[as.size() / 2], 0.08, 0.01) << "seed " << seed;
+    EXPECT_NEAR(bs[bs.size() / 2], 0.05, 0.01) << "seed " << seed;
+    mean_a += as[as.size() / 2] / kSeeds;
+    mean_b += bs[bs.size() / 2] / kSeeds;
   }
-  std::nth_element(as.begin(), as.begin() + as.size() / 2, as.end());
-  std::nth_element(bs.begin(), bs.begin() + bs.size() / 2, bs.end());
-  EXPECT_NEAR(as[as.size() / 2], 0.08, 0.005) << "seed " << seed;
-  EXPECT_NEAR(bs[bs.size() / 2], 0.05, 0.005) << "seed " << seed;
+  EXPECT_LT(error, 0.05);
+  EXPECT_NEAR(mean_a, 0.08, 0.004);
+  EXPECT_NEAR(mean_b, 0.05, 0.004);
 }
 
 TEST(PatchMatch, FrontParallelModeKeepsNormalsFlat) {

@@ -80,6 +80,24 @@ TEST(PatchMatchCost, ConfidenceWeightsTheLidarTermAndTheImageTermTakesTheRest) {
   EXPECT_FLOAT_EQ(costOf(paper_cost, 9, 4, pm::Plane{0.f, 0.f, 6.f}), 9.f * (1.f + 0.9f));
 }
 
+TEST(PatchMatchCost, TheRoundWindowSumsTheSamplesWithinTheRadius) {
+  // params3x3's images with a round 3x3 window: the centre and its 4 neighbours (the corners lie
+  // sqrt(2) px away), each costing 1 as in the square's test above.
+  lsf::PatchMatchParams p = params3x3();
+  p.window_round = true;
+  const Views v = prepare({uniform(12, 9, 100)}, {uniform(12, 9, 104)}, p);
+  const pm::MatchingCost cost(p, v.left, v.right);
+  EXPECT_EQ(cost.rows().count, 5);
+  EXPECT_FLOAT_EQ(costOf(cost, 6, 4, pm::Plane{0.f, 0.f, 2.f}), 5.f);
+  // On the top row the sample above is outside the image: 4 samples.
+  EXPECT_FLOAT_EQ(costOf(cost, 6, 0, pm::Plane{0.f, 0.f, 2.f}), 4.f);
+  // The square: 9 and, on the top row, 6.
+  p.window_round = false;
+  const pm::MatchingCost square(p, v.left, v.right);
+  EXPECT_FLOAT_EQ(costOf(square, 6, 4, pm::Plane{0.f, 0.f, 2.f}), 9.f);
+  EXPECT_FLOAT_EQ(costOf(square, 6, 0, pm::Plane{0.f, 0.f, 2.f}), 6.f);
+}
+
 TEST(PatchMatchCost, PaperReadingChargesTheTruncationWhereThePriorIsEmpty) {
   lsf::PatchMatchParams p = params3x3();
   p.confidence_weighting = false;
@@ -175,6 +193,26 @@ TEST(PatchMatchCost, WindowOffsetsAreEveryStrideOrDyadic) {
   EXPECT_EQ(pm::windowOffsets(4, 1, true), (std::vector<int>{-4, -2, -1, 0, 1, 2, 4}));
   EXPECT_EQ(pm::windowOffsets(6, 2, true), (std::vector<int>{-4, -2, 0, 2, 4}));
   EXPECT_EQ(pm::windowOffsets(5, 5, true), pm::windowOffsets(5, 5, false));  // {-5, 0, 5}
+}
+
+TEST(PatchMatchCost, WindowRowsAreTheSquareOrTheDiscWithinTheRadius) {
+  const std::vector<int> dyadic = pm::windowOffsets(8, 2, true);  // -8 -4 -2 0 2 4 8
+  const pm::WindowRows square = pm::windowRows(dyadic, 8, false);
+  EXPECT_EQ(square.first, std::vector<int>(7, 0));
+  EXPECT_EQ(square.end, std::vector<int>(7, 7));
+  EXPECT_EQ(square.count, 49);
+  // Round: rows +-8 hold dx = 0 alone; rows +-4 and +-2 hold |dx| <= 4 (4^2 + 8^2 > 64); row 0
+  // all seven.
+  const pm::WindowRows round = pm::windowRows(dyadic, 8, true);
+  EXPECT_EQ(round.first, (std::vector<int>{3, 1, 1, 0, 1, 1, 3}));
+  EXPECT_EQ(round.end, (std::vector<int>{4, 6, 6, 7, 6, 6, 4}));
+  EXPECT_EQ(round.count, 29);
+  // The levels of the coarse start: radius 4, stride 1 (-4 -2 -1 0 1 2 4) and radius 2, stride 1.
+  EXPECT_EQ(pm::windowRows(pm::windowOffsets(4, 1, true), 4, true).count, 29);
+  EXPECT_EQ(pm::windowRows(pm::windowOffsets(2, 1, true), 2, true).count, 13);
+  // The paper's 3x3 samples of 11x11 (-5 0 5): the corners are 7.1 px away.
+  EXPECT_EQ(pm::windowRows(pm::windowOffsets(5, 5, false), 5, true).count, 5);
+  EXPECT_EQ(pm::windowRows(pm::windowOffsets(5, 5, false), 5, false).count, 9);
 }
 
 TEST(PatchMatchSearch, SubpixelStepMovesDToTheCostMinimum) {

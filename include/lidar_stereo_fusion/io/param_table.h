@@ -59,6 +59,7 @@ void visitParamTable(P& p, V&& v) {
   v(ParamName{"window_radius", pm}, m.window_radius);
   v(ParamName{"window_stride", pm}, m.window_stride);
   v(ParamName{"window_dyadic", pm}, m.window_dyadic);
+  v(ParamName{"window_round", pm}, m.window_round);
   v(ParamName{"weight_delta", pm}, m.weight_delta);
   v(ParamName{"image_smoothing", pm}, m.image_smoothing);
   v(ParamName{"alpha", pm}, m.alpha);

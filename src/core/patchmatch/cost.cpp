@@ -34,6 +34,23 @@ std::vector<int> windowOffsets(int radius, int stride, bool dyadic) {
   return offsets;
 }
 
+WindowRows windowRows(const std::vector<int>& offsets, int radius, bool round) {
+  WindowRows rows;
+  const int m = static_cast<int>(offsets.size());
+  for (int dy : offsets) {
+    int first = 0, end = m;
+    if (round) {
+      const auto inside = [&](int dx) { return dx * dx + dy * dy <= radius * radius; };
+      while (first < end && !inside(offsets[first])) ++first;
+      while (end > first && !inside(offsets[end - 1])) --end;
+    }
+    rows.first.push_back(first);
+    rows.end.push_back(end);
+    rows.count += end - first;
+  }
+  return rows;
+}
+
 void WindowCache::reserve(size_t n) {
   for (auto* v : {&xs, &ys, &w_img, &w_lidar, &priors}) v->assign(n, 0.f);
   texels.assign(n, Texel{});
@@ -44,6 +61,7 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
                            const ViewState& other)
     : p_(params), self_(self), other_(other) {
   offsets_ = windowOffsets(params.window_radius, params.window_stride, params.window_dyadic);
+  rows_ = windowRows(offsets_, params.window_radius, params.window_round);
   weight_lut_.resize(kLutSize);
   for (int i = 0; i < kLutSize; ++i) {
     weight_lut_[i] = std::exp(-(i / kLutScale) / static_cast<float>(params.weight_delta));
@@ -61,17 +79,21 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
   avx2_ = activeSimdPath() != SimdPath::kBaseline;
   avx512_ = activeSimdPath() == SimdPath::kAvx512;
-  // A window wholly inside the image has the same samples at the same offsets for every pixel.
-  const int m = static_cast<int>(offsets_.size());
+  // A window wholly inside the image has the same samples at the same offsets for every pixel;
+  // the padding repeats the first sample.
   const int other_stride = kTexelChannels * other_.width;
-  for (int k = 0; k < (m * m + kSimdBlock - 1) / kSimdBlock * kSimdBlock; ++k) {
-    const int i = k < m * m ? k : 0;  // the padding repeats the first sample
-    const int dy = offsets_[i / m], dx = offsets_[i % m];
+  const auto add_interior = [&](int dx, int dy) {
     interior_dx_.push_back(static_cast<float>(dx));
     interior_dy_.push_back(static_cast<float>(dy));
     interior_row_.push_back(dy * other_stride);
     interior_texel_.push_back((dy * self_.width + dx) * kTexelChannels);
     interior_pixel_.push_back(dy * self_.width + dx);
+  };
+  for (size_t i = 0; i < offsets_.size(); ++i) {
+    for (int j = rows_.first[i]; j < rows_.end[i]; ++j) add_interior(offsets_[j], offsets_[i]);
+  }
+  while (interior_dx_.size() % kSimdBlock != 0) {
+    add_interior(static_cast<int>(interior_dx_[0]), static_cast<int>(interior_dy_[0]));
   }
   const bool pixel_steps = !use_prior_ || (static_cast<int>(self_.prior.step1()) == self_.width &&
                                            static_cast<int>(self_.trust.step1()) == self_.width);
@@ -86,6 +108,9 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
                             other_stride,
                             offsets_.data(),
                             static_cast<int>(offsets_.size()),
+                            rows_.first.data(),
+                            rows_.end.data(),
+                            rows_.count,
                             weight_lut_.data(),
                             kLutSize,
                             kLutScale,
@@ -136,13 +161,13 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
   const short* texels = self_.texels.data()->v;
   const short* center = texels + (static_cast<long>(py) * self_.width + px) * kTexelChannels;
   const float texel_unit = 1.f / static_cast<float>(kTexelScale);  // exact: a power of two
-  for (int dy : offsets_) {
-    const int y = py + dy;
+  for (size_t i = 0; i < offsets_.size(); ++i) {
+    const int y = py + offsets_[i];
     if (y < 0 || y >= self_.height) continue;
     const float* prow = use_prior_ ? self_.prior.ptr<float>(y) : nullptr;
     const float* trow = use_prior_ ? self_.trust.ptr<float>(y) : nullptr;
-    for (int dx : offsets_) {
-      const int x = px + dx;
+    for (int j = rows_.first[i]; j < rows_.end[i]; ++j) {
+      const int x = px + offsets_[j];
       if (x < 0 || x >= self_.width) continue;
       const Texel& t = self_.texels[static_cast<size_t>(y) * self_.width + x];
       const int l1 = std::abs(t.v[0] - center[0]) + std::abs(t.v[1] - center[1]) +

@@ -164,28 +164,32 @@ void writePadding(const KernelWindowOut& out, int from, int to) {
 /// positions are written 8 at a time (the arrays have kSimdBlock entries of room; what a row
 /// writes beyond its samples is overwritten by the next row or the padding).
 int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& out, int padded_max) {
-  // The offsets increase, so the columns inside the image are one range [j0, j1).
+  // The offsets increase, so the columns inside the image are one range [j0, j1), and a row's
+  // samples inside it one range [a, b) (the window's row [row_first, row_end) cut by it).
   int j0 = 0, j1 = s.offset_count;
   while (j0 < j1 && px + s.offsets[j0] < 0) ++j0;
   while (j1 > j0 && px + s.offsets[j1 - 1] >= s.width) --j1;
-  const int m = j1 - j0;
   // Locals, not s's members: the stores below could alias them as far as the compiler knows.
-  const int* const cols = s.offsets + j0;
   const short* const texels = s.texels;
   const float* const prior = s.prior;
   const float* const trust = s.trust;
   alignas(32) float xcol[kMaxOffsets + kSimdBlock];
-  for (int j = 0; j < m + kSimdBlock; ++j) {
-    xcol[j] = j < m ? static_cast<float>(px + s.offsets[j0 + j]) : 0.f;
+  for (int j = 0; j < s.offset_count + kSimdBlock; ++j) {
+    xcol[j] = j < s.offset_count ? static_cast<float>(px + s.offsets[j]) : 0.f;
   }
   int k = 0;
   for (int i = 0; i < s.offset_count; ++i) {
     const int y = py + s.offsets[i];
     if (y < 0 || y >= s.height) continue;
+    const int a = j0 > s.row_first[i] ? j0 : s.row_first[i];
+    const int b = j1 < s.row_end[i] ? j1 : s.row_end[i];
+    const int m = b - a;
+    if (m <= 0) continue;
+    const int* const cols = s.offsets + a;
     const __m256 fy = _mm256_set1_ps(static_cast<float>(y));
     const __m256i row = _mm256_set1_epi32(y * s.other_texel_stride);
     for (int q = 0; q < m; q += kSimdBlock) {
-      _mm256_storeu_ps(out.xs + k + q, _mm256_load_ps(xcol + q));
+      _mm256_storeu_ps(out.xs + k + q, _mm256_loadu_ps(xcol + a + q));
       _mm256_storeu_ps(out.ys + k + q, fy);
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.texel_row + k + q), row);
     }
@@ -327,7 +331,7 @@ void interiorWindow(const KernelSelf& s, int px, int py, const KernelWindowOut& 
 
 int buildWindowAvx2(const KernelSelf& s, int px, int py, const KernelWindowOut& out, int& padded,
                     float& constant) {
-  const int n = s.offset_count * s.offset_count;
+  const int n = s.sample_count;
   const int padded_max = (n + kSimdBlock - 1) / kSimdBlock * kSimdBlock;
   constant = 0.f;
   const __m128i center128 = _mm_load_si128(reinterpret_cast<const __m128i*>(

@@ -54,6 +54,16 @@ struct WindowCache {
 /// with `dyadic` 0, +-stride, +-2 stride, +-4 stride, ... within `radius`.
 std::vector<int> windowOffsets(int radius, int stride, bool dyadic);
 
+/// The window's samples, row by row on the grid of `offsets` (windowOffsets): row i (dy =
+/// offsets[i]) holds the columns j in [first[i], end[i]) (dx = offsets[j]). Square: every column
+/// of every row; round: the samples with dx^2 + dy^2 <= radius^2 (a disc: each row an interval,
+/// since the offsets ascend; a row outside the disc is empty, first = end).
+struct WindowRows {
+  std::vector<int> first, end;
+  int count = 0;  ///< samples in the window
+};
+WindowRows windowRows(const std::vector<int>& offsets, int radius, bool round);
+
 class MatchingCost {
  public:
   /// Uses the AVX2 kernels when activeSimdPath() is kAvx2, and the AVX-512 cost with the AVX2
@@ -87,6 +97,9 @@ class MatchingCost {
   /// The window offsets used in x and y (windowOffsets of the parameters).
   const std::vector<int>& offsets() const { return offsets_; }
 
+  /// The window's samples on the offsets' grid (windowRows of the parameters).
+  const WindowRows& rows() const { return rows_; }
+
  private:
   float aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const;
   void aggregateSidesImpl(const WindowCache& cache, const Plane& plane, float h, int shift_q,
@@ -99,6 +112,7 @@ class MatchingCost {
   const ViewState& self_;
   const ViewState& other_;
   std::vector<int> offsets_;
+  WindowRows rows_;
   std::vector<float> weight_lut_;
   /// KernelSelf's interior window: the samples' offsets (cost_kernel.h).
   std::vector<float> interior_dx_, interior_dy_;

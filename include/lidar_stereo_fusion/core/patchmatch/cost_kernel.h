@@ -63,6 +63,9 @@ struct KernelSelf {
   int other_texel_stride;  ///< shorts per row of the other view's texels
   const int* offsets;      ///< window offsets in x and y [px]
   int offset_count;
+  /// Row i of the window holds the columns [row_first[i], row_end[i]) (WindowRows, cost.h).
+  const int *row_first, *row_end;
+  int sample_count;  ///< samples of a window wholly inside the image
   const float* weight_lut;  ///< w by L1 colour distance times lut_scale
   int lut_size;
   float lut_scale;  ///< LUT entries per unit of RGB L1 distance
