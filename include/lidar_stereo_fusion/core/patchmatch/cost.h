@@ -56,8 +56,8 @@ std::vector<int> windowOffsets(int radius, int stride, bool dyadic);
 
 /// The window's samples, row by row on the grid of `offsets` (windowOffsets): row i (dy =
 /// offsets[i]) holds the columns j in [first[i], end[i]) (dx = offsets[j]). Square: every column
-/// of every row; round: the samples with dx^2 + dy^2 <= radius^2 (a disc: each row an interval,
-/// since the offsets ascend; a row outside the disc is empty, first = end).
+/// of every row; round: the samples with dx^2 + dy^2 <= radius^2 (a disc: each row an interval
+/// around dx = 0, since the offsets ascend).
 struct WindowRows {
   std::vector<int> first, end;
   int count = 0;  ///< samples in the window
