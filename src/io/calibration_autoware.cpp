@@ -174,6 +174,7 @@ AutowareCalibration readAutowareCalibration(const std::string& path) {
   }
   const std::string text = readTextFile(path, "Autoware calibration");
   requireTextFile(text, path, "Autoware calibration");
+  requireYamlMarkersAlone(text, path, "Autoware calibration");
   requireAutowareLayout(text, path);
   cv::FileStorage fs;
   try {

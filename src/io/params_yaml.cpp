@@ -176,6 +176,7 @@ std::string withYamlDirective(const std::string& text) {
 cv::FileStorage openYaml(const std::string& path) {
   const std::string raw = readTextFile(path, "params YAML");
   requireTextFile(raw, path, "params YAML");
+  requireYamlMarkersAlone(raw, path, "params YAML");
   const std::string text = withYamlDirective(raw);
   cv::FileStorage fs;
   try {

@@ -309,6 +309,27 @@ TEST(ParamsYaml, WrongTypesAndInvalidValuesAreErrorsNamingTheKey) {
   EXPECT_NE(invalid.find("window_radius"), std::string::npos) << invalid;
 }
 
+TEST(ParamsYaml, ContentOnADocumentMarkerLineIsAnErrorNamingTheLine) {
+  // OpenCV's YAML parser loops forever on these (found by fuzzing; text_file.h): they must be
+  // rejected before they reach it.
+  for (const char* text :
+       {"---hod: pms\npat--hod: pms\npatchmchm seed: \"71}\n", "---hod: pms\npat-hod: pms\nc: 1\n",
+        "--- hod: pms\npat-hod: pms\nc: 1\n"}) {
+    const std::string error = loadError(text);
+    EXPECT_NE(error.find("line 1: '---'"), std::string::npos) << error;
+  }
+  const std::string end = loadError("method: pms\n... seed: 3\n");
+  EXPECT_NE(end.find("line 2: '...'"), std::string::npos) << end;
+  // A marker alone, or with blanks or a comment after it, is fine.
+  for (const char* text :
+       {"---\nmethod: pms\n", "---   \nmethod: pms\n", "--- # doc\nmethod: pms\n"}) {
+    YamlFile alone(text);
+    FusionParams p;
+    EXPECT_NO_THROW(loadParamsYaml(alone.path(), p)) << text;
+    EXPECT_EQ(p.method, Method::kPlainPMS) << text;
+  }
+}
+
 TEST(ParamsYaml, FailedLoadLeavesParamsUntouchedAndMissingFileIsAnError) {
   YamlFile file("bi:\n  max_gap_px: 5\n  nonsense: 1\n");
   FusionParams p;

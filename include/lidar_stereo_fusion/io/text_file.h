@@ -14,4 +14,13 @@ std::string readTextFile(const std::string& path, const std::string& what);
 /// binary input (found by fuzzing the Autoware reader), so such files never reach it.
 void requireTextFile(const std::string& text, const std::string& path, const std::string& what);
 
+/// Throws std::runtime_error "<what> <path> line N: ..." when a YAML document marker ("---" or
+/// "...", after any indentation) has anything but blanks or a comment after it on its line.
+/// OpenCV 4.6's YAML parser loops forever on some such files: a collection that begins on the
+/// marker's line ends at the next less indented line, and the parser then skips three characters
+/// as if they were a marker; a lone '-' there makes its search for the next document spin
+/// without advancing (found by fuzzing the parameter reader: "---hod: pms\npat-hod: pms\nc: 1").
+void requireYamlMarkersAlone(const std::string& text, const std::string& path,
+                             const std::string& what);
+
 }  // namespace lidar_stereo_fusion
