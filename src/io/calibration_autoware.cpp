@@ -174,8 +174,8 @@ AutowareCalibration readAutowareCalibration(const std::string& path) {
   }
   const std::string text = readTextFile(path, "Autoware calibration");
   requireTextFile(text, path, "Autoware calibration");
-  requireYamlMarkersAlone(text, path, "Autoware calibration");
   requireAutowareLayout(text, path);
+  requireYamlMarkersAlone(text, path, "Autoware calibration");
   cv::FileStorage fs;
   try {
     fs.open(path, cv::FileStorage::READ);
