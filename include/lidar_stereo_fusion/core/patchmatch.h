@@ -28,7 +28,7 @@ struct PatchMatchParams {
   /// disc; 29 of the 7x7 dyadic samples of 17x17: the 5x5 within +-4 and the 4 axis ends at 8).
   /// The square's corners are the samples farthest from the centre; the cost kernel takes 16
   /// samples a step, so 29 samples are 2 steps instead of 4 (about 20 % of the frame's time). On
-  /// the accuracy protocols: KITTI hold-out MAE +2 %, Middlebury within 1.5 % (README).
+  /// the accuracy protocols: KITTI hold-out MAE +2 %, Middlebury within 2 % (README).
   bool window_round = true;
   double weight_delta = 10.0;    ///< delta of w = exp(-|I_p - I_p'|_1 / delta)
   /// [px] sigma of a 3x3 Gaussian applied to both images before matching (0 = off). Linear
