@@ -21,22 +21,17 @@ namespace {
 /// loop forever on some malformed input (found by fuzzing: a bare "5, -1," line before "---at:";
 /// indented lines before any key), so files of another shape never reach it.
 void requireAutowareLayout(const std::string& text, const std::string& path) {
-  std::size_t start = 0;
   bool seen_key = false;
-  for (int number = 1; start <= text.size(); ++number) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(start, end - start);
-    start = end + 1;
+  forEachLine(text, [&](int number, std::string_view line) {
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) {
-      line.pop_back();
+      line.remove_suffix(1);
     }
     if (line.empty() || line[0] == '#' || line == "---" ||
         ((line == "%YAML:1.0" || line == "%YAML 1.0") && number == 1)) {
-      continue;
+      return;
     }
     if (line[0] == ' ' || line[0] == '\t') {
-      if (seen_key) continue;  // a continuation of the key above
+      if (seen_key) return;  // a continuation of the key above
       throw std::runtime_error("Autoware calibration " + path + ": line " + std::to_string(number) +
                                " is indented but no 'Key: value' line comes before it");
     }
@@ -50,10 +45,10 @@ void requireAutowareLayout(const std::string& text, const std::string& path) {
                            (key_end + 1 == line.size() || line[key_end + 1] == ' ');
     if (!key_value) {
       throw std::runtime_error("Autoware calibration " + path + ": line " + std::to_string(number) +
-                               " is not 'Key: value' (" + line.substr(0, 40) + ")");
+                               " is not 'Key: value' (" + std::string(line.substr(0, 40)) + ")");
     }
     seen_key = true;
-  }
+  });
 }
 
 std::string where(const std::string& path, const std::string& key) {

@@ -27,22 +27,18 @@ void requireTextFile(const std::string& text, const std::string& path, const std
 
 void requireYamlMarkersAlone(const std::string& text, const std::string& path,
                              const std::string& what) {
-  std::size_t line_start = 0;
-  for (int line = 1; line_start < text.size(); ++line) {
-    std::size_t line_end = text.find('\n', line_start);
-    if (line_end == std::string::npos) line_end = text.size();
-    const std::size_t first = text.find_first_not_of(" \t", line_start);
-    if (first < line_end &&
-        (text.compare(first, 3, "---") == 0 || text.compare(first, 3, "...") == 0)) {
-      const std::size_t rest = text.find_first_not_of(" \t\r", first + 3);
-      if (rest < line_end && text[rest] != '#') {
-        throw std::runtime_error(what + " " + path + " line " + std::to_string(line) + ": '" +
-                                 text.substr(first, 3) +
-                                 "' (a YAML document marker) must be alone on its line");
-      }
+  forEachLine(text, [&](int number, std::string_view line) {
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string_view::npos) return;
+    const std::string_view marker = line.substr(first, 3);
+    if (marker != "---" && marker != "...") return;
+    const std::size_t rest = line.find_first_not_of(" \t\r", first + 3);
+    if (rest != std::string_view::npos && line[rest] != '#') {
+      throw std::runtime_error(what + " " + path + " line " + std::to_string(number) + ": '" +
+                               std::string(marker) +
+                               "' (a YAML document marker) must be alone on its line");
     }
-    line_start = line_end + 1;
-  }
+  });
 }
 
 }  // namespace lidar_stereo_fusion

@@ -1,12 +1,27 @@
 // Text files handed to OpenCV's FileStorage (parameters, calibrations). ROS-free.
 #pragma once
 
+#include <cstddef>
 #include <string>
+#include <string_view>
 
 namespace lidar_stereo_fusion {
 
 /// The whole file at `path`; std::runtime_error "<what>: cannot open <path>" when unreadable.
 std::string readTextFile(const std::string& path, const std::string& what);
+
+/// Calls f(number, line) for each line of `text`, numbered from 1, without its '\n' (a '\r'
+/// before it stays). A last line without '\n' is a line; an empty text has none.
+template <typename F>
+void forEachLine(std::string_view text, F&& f) {
+  std::size_t start = 0;
+  for (int number = 1; start < text.size(); ++number) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string_view::npos) end = text.size();
+    f(number, text.substr(start, end - start));
+    start = end + 1;
+  }
+}
 
 /// Throws std::runtime_error "<what> <path>: not a text file (control byte B at offset N)" when
 /// `text` has control bytes other than tab, CR and LF. OpenCV reads a buffer only up to its first
