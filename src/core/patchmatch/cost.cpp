@@ -143,7 +143,7 @@ float MatchingCost::supportWeight(float l1) const {
 }
 
 void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
-  const size_t n = offsets_.size() * offsets_.size() + kSimdBlock;  // room for the padding
+  const size_t n = rows_.count + kSimdBlock;  // room for the padding
   if (cache.xs.size() < n) cache.reserve(n);
   if (avx2_) {
     const KernelWindowOut out{cache.xs.data(),       cache.ys.data(),     cache.w_img.data(),
