@@ -494,6 +494,28 @@ TEST(FrameMatcher, WaitIsInRosTimeSoThePlaybackRateDoesNotMatter) {
   EXPECT_EQ(ev.ready[0].sweep, 1);
 }
 
+// Under /use_sim_time ROS time is zero until the first /clock, and a bag's first image set can
+// arrive before it. The clock's first tick (from zero to the bag's time) is not a wait: the set
+// still gets the sweep that comes after it, and gives up only max_wait after the first known time.
+TEST(FrameMatcher, SetArrivingBeforeTheFirstClockWaitsFromTheFirstKnownTime) {
+  Matcher m;  // max_wait 0.3 s
+  EXPECT_TRUE(m.addImages(ros::Time(10.0), 100, ros::Time(0)).ready.empty());
+  EXPECT_TRUE(m.poll(ros::Time(0)).unmatched.empty());
+  EXPECT_TRUE(m.poll(ros::Time(10.002)).unmatched.empty()) << "given up at the clock's first tick";
+  EXPECT_TRUE(m.poll(ros::Time(10.2)).unmatched.empty());
+  auto ev = m.addSweep(ros::Time(10.04), 2, ros::Time(10.21));
+  ASSERT_EQ(ev.ready.size(), 1u);
+  EXPECT_EQ(ev.ready[0].sweep, 2);
+
+  Matcher late;
+  late.addImages(ros::Time(10.0), 100, ros::Time(0));
+  EXPECT_TRUE(late.poll(ros::Time(10.002)).unmatched.empty());
+  EXPECT_TRUE(late.poll(ros::Time(10.3)).unmatched.empty());
+  ev = late.poll(ros::Time(10.303));
+  ASSERT_EQ(ev.unmatched.size(), 1u);
+  EXPECT_TRUE(ev.unmatched_waited[0]);
+}
+
 TEST(FrameMatcher, NoSweepWithinTheOffsetIsUnmatched) {
   Matcher m;  // max_time_offset 0.1
   const ros::Time now(100.0);

@@ -118,10 +118,18 @@ class FrameMatcher {
   struct Pending {
     ros::Time stamp;
     Images images;
-    ros::Time arrival;  ///< ROS time of arrival
+    ros::Time arrival;  ///< ROS time of arrival; zero until ROS time is known (resolve)
   };
 
   void resolve(Events& events, const ros::Time& now) {
+    // ROS time zero is time not yet known (/use_sim_time before the first /clock): a bag's first
+    // image set can come before the clock's first tick, on its own connection. Its wait starts at
+    // the first known time, or that tick (a jump from zero) would give it up at once.
+    if (!now.isZero()) {
+      for (Pending& p : pending_) {
+        if (p.arrival.isZero()) p.arrival = now;
+      }
+    }
     while (!pending_.empty()) {
       Pending& p = pending_.front();
       const bool later_sweep_seen = !sweeps_.empty() && sweeps_.back().first >= p.stamp;
