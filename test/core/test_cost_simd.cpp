@@ -429,9 +429,14 @@ TEST(CostSimd, PatchMatchSameOnBothPaths) {
       confidence(y, x) = (x % 7) / 6.f;
     }
   }
-  for (const bool weighted : {true, false}) {
+  for (const int variant : {0, 1, 2}) {  // confidence-weighted, the paper's cost, the live preset
+    const bool weighted = variant != 1;
     lsf::PatchMatchParams p;
     p.confidence_weighting = weighted;
+    if (variant == 2) {
+      p.unbounded_scale = 2;
+      p.intermediate_refine = false;
+    }
     p.num_threads = 2;
     const lsf::ViewInput left(s.left, prior, {}, confidence), right(s.right, cv::Mat1f(), {});
     lsf::setSimdPath(lsf::SimdPath::kBaseline);
@@ -440,12 +445,12 @@ TEST(CostSimd, PatchMatchSameOnBothPaths) {
       lsf::setSimdPath(wide);
       const auto fast = lsf::PatchMatchStereo(p).compute(left, right);
       const double differ = differingFraction(fast.disparity, base.disparity);
-      std::printf("[          ] %s, confidence_weighting %d: %.4f %% of pixels differ by > 1e-3 "
-                  "px\n",
-                  lsf::simdLevel(), weighted, 100 * differ);
-      EXPECT_LE(differ, 1e-3) << lsf::simdLevel() << " confidence_weighting " << weighted;
+      std::printf("[          ] %s, variant %d: %.4f %% of pixels differ by > 1e-3 px\n",
+                  lsf::simdLevel(), variant, 100 * differ);
+      EXPECT_LE(differ, 1e-3) << lsf::simdLevel() << " variant " << variant;
       EXPECT_EQ(cv::norm(fast.disparity, base.disparity, cv::NORM_INF), 0.0)
-          << lsf::simdLevel() << ": the kernels are bit-identical, so should be the results";
+          << lsf::simdLevel() << " variant " << variant
+          << ": the kernels are bit-identical, so should be the results";
     }
   }
 }

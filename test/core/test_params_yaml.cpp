@@ -76,7 +76,9 @@ FusionParams everyFieldChanged() {
   m.coarse_scale = 3;
   m.coarse_levels = 3;
   m.full_size_unbounded = true;
+  m.unbounded_scale = 9;  // coarse_scale^2
   m.skip_inconsistent = false;
+  m.intermediate_refine = false;
   m.fine_iterations = 2;
   m.fine_refine_range = 1.5;
   p.confidence.edge_tolerance = 0.25;
@@ -135,6 +137,8 @@ void expectSame(const FusionParams& a, const FusionParams& b) {
   EXPECT_EQ(x.coarse_levels, y.coarse_levels);
   EXPECT_EQ(x.full_size_unbounded, y.full_size_unbounded);
   EXPECT_EQ(x.skip_inconsistent, y.skip_inconsistent);
+  EXPECT_EQ(x.unbounded_scale, y.unbounded_scale);
+  EXPECT_EQ(x.intermediate_refine, y.intermediate_refine);
   EXPECT_EQ(x.fine_iterations, y.fine_iterations);
   EXPECT_EQ(x.fine_refine_range, y.fine_refine_range);
   const PriorConfidenceParams &c = a.confidence, &d = b.confidence;
@@ -269,6 +273,19 @@ TEST(ParamsYaml, ThePaperPresetHasThePapersCostAndWindow) {
   EXPECT_EQ(p.patchmatch.coarse_scale, 1);
   FusionParams expected;
   expected.patchmatch = p.patchmatch;  // the rest must be the defaults
+  expectSame(p, expected);
+}
+
+// config/live.yaml cuts the search (issue 21); everything else stays at the defaults.
+TEST(ParamsYaml, TheLivePresetCutsTheSearchOnly) {
+  FusionParams p;
+  loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/live.yaml", p);
+  EXPECT_EQ(p.method, Method::kFusedBI);
+  EXPECT_EQ(p.patchmatch.unbounded_scale, 2);
+  EXPECT_FALSE(p.patchmatch.intermediate_refine);
+  FusionParams expected;
+  expected.patchmatch.unbounded_scale = 2;
+  expected.patchmatch.intermediate_refine = false;
   expectSame(p, expected);
 }
 

@@ -1,4 +1,6 @@
 // Guided PatchMatch on synthetic stereo pairs with exactly known disparity.
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -165,14 +167,20 @@ TEST(PatchMatch, ScratchBuffersDoNotLeakBetweenFrames) {
 
 TEST(PatchMatch, DeterministicForSeedAndThreadCount) {
   const PlaneScene s = PlaneScene::make(120, 64, 0.03, 0.0, 9.0, 21);
-  auto p = stereoOnly();
-  p.num_threads = 1;
-  const auto a = lsf::PatchMatchStereo(p).compute({s.left, cv::Mat1f(), {}},
-                                                  {s.right, cv::Mat1f(), {}});
-  p.num_threads = 2;
-  const auto b = lsf::PatchMatchStereo(p).compute({s.left, cv::Mat1f(), {}},
-                                                  {s.right, cv::Mat1f(), {}});
-  EXPECT_EQ(cv::norm(a.disparity, b.disparity, cv::NORM_INF), 0.0);
+  for (const bool live : {false, true}) {  // the default and the live preset's search
+    auto p = stereoOnly();
+    if (live) {
+      p.unbounded_scale = 2;
+      p.intermediate_refine = false;
+    }
+    p.num_threads = 1;
+    const auto a = lsf::PatchMatchStereo(p).compute({s.left, cv::Mat1f(), {}},
+                                                    {s.right, cv::Mat1f(), {}});
+    p.num_threads = 2;
+    const auto b = lsf::PatchMatchStereo(p).compute({s.left, cv::Mat1f(), {}},
+                                                    {s.right, cv::Mat1f(), {}});
+    EXPECT_EQ(cv::norm(a.disparity, b.disparity, cv::NORM_INF), 0.0) << "live " << live;
+  }
 }
 
 TEST(PatchMatch, RejectsBadInput) {
@@ -184,6 +192,24 @@ TEST(PatchMatch, RejectsBadInput) {
   EXPECT_THROW(q.validate(), std::invalid_argument);
   q.right_iterations = -2;
   EXPECT_THROW(q.validate(), std::invalid_argument);
+  // unbounded_scale is a level's reduction factor: 1, 2 or 4 with two levels of 2.
+  lsf::PatchMatchParams u;
+  for (const int scale : {1, 2, 4}) {
+    u.unbounded_scale = scale;
+    EXPECT_NO_THROW(u.validate()) << scale;
+  }
+  for (const int scale : {0, 3, 8}) {
+    u.unbounded_scale = scale;
+    try {
+      u.validate();
+      ADD_FAILURE() << "unbounded_scale " << scale << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("unbounded_scale"), std::string::npos) << e.what();
+    }
+  }
+  u.unbounded_scale = 2;
+  u.coarse_scale = 1;  // no coarse start: no level but full size
+  EXPECT_THROW(u.validate(), std::invalid_argument);
   lsf::PatchMatchStereo pm;
   cv::Mat a(10, 20, CV_8UC3), b(10, 21, CV_8UC3);
   EXPECT_THROW(pm.compute({a, cv::Mat1f(), {}}, {b, cv::Mat1f(), {}}), std::invalid_argument);

@@ -1,8 +1,9 @@
 // Ring hold-out on the real KITTI drive (io/accuracy_protocols.h): 32 rings fed (ring % 2 == 0) and
 // 16 rings fed (ring % 4 == 0), every other ring's points the reference depth, 11 frames, empty
-// pixels filled like the KITTI devkit before scoring. The default fused method must have a lower
-// MAE and a lower >3 px rate than LiDAR-only BI* on both, by a margin; the paper preset must
-// reproduce the fused_bi numbers of the package before confidence weighting.
+// pixels filled like the KITTI devkit before scoring. The default fused method and the live preset
+// (config/live.yaml) must each have a lower MAE and a lower >3 px rate than LiDAR-only BI* on
+// both, by a margin; the paper preset must reproduce the fused_bi numbers of the package before
+// confidence weighting.
 //
 // Plain PMS (~50 s per frame on 2 cores) is left to the accuracy_report tool.
 #include <iostream>
@@ -53,6 +54,25 @@ TEST(KittiHoldout, FusedBeatsLidarOnlyOn32And16RingsAndThePaperPresetReproducesI
     EXPECT_LT(fused.bad3, (1 - kMargin) * lidar.bad3) << layout.name;
     EXPECT_NEAR(old.mae_mm, previous[i].mae_mm, 0.01 * previous[i].mae_mm) << layout.name;
     EXPECT_NEAR(old.bad3, previous[i].bad3, 0.01 * previous[i].bad3) << layout.name;
+  }
+}
+
+TEST(KittiHoldout, TheLivePresetBeatsLidarOnlyOn32And16Rings) {
+  LSF_REQUIRE_DATA(kDrive);
+  AccuracyOptions options;
+  options.data_dir = LSF_DATA_DIR;
+  options.methods = {"fused", "lidar_bi"};
+  options.kitti_pms = false;
+  loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/live.yaml", options.fused);
+  const auto layouts = runKittiProtocol(options);
+  ASSERT_EQ(layouts.size(), 2u);
+  for (const auto& layout : layouts) {
+    const DepthMetrics& live = all(layout, "fused");
+    const DepthMetrics& lidar = all(layout, "lidar_bi");
+    std::cout << layout.name << ": live MAE " << live.mae_mm << " mm, >3 px " << 100 * live.bad3
+              << " %; lidar_bi " << lidar.mae_mm << " mm, " << 100 * lidar.bad3 << " %\n";
+    EXPECT_LT(live.mae_mm, (1 - kMargin) * lidar.mae_mm) << layout.name;
+    EXPECT_LT(live.bad3, (1 - kMargin) * lidar.bad3) << layout.name;
   }
 }
 

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -45,4 +46,24 @@ TEST(LaunchFiles, RigLaunchUsesWallClockAndNamesTheDrivers) {
   EXPECT_NE(rig.find("(velodyne_pointcloud):"), std::string::npos) << rig;
   const std::string without = dumpParams("zed_vls128.launch", "start_zed:=false");
   EXPECT_EQ(without.find("ZED (zed_wrapper): started"), std::string::npos) << without;
+}
+
+TEST(LaunchFiles, PresetLiveLoadsConfigLiveEverywhere) {
+  // fusion.launch, playback.launch and measure_live.launch take preset:=live; the rig's default is
+  // live (README: presets).
+  for (const auto& [launch, args] :
+       {std::pair<std::string, std::string>{"fusion.launch", "preset:=live"},
+        {"playback.launch", "bag:=/nonexistent.bag preset:=live"},
+        {"measure_live.launch", "preset:=live"},
+        {"zed_vls128.launch", ""}}) {
+    const std::string dump = dumpParams(launch, args);
+    EXPECT_NE(dump.find("/fusion/fusion/unbounded_scale: 2"), std::string::npos)
+        << launch << "\n" << dump;
+    EXPECT_NE(dump.find("/fusion/fusion/intermediate_refine: false"), std::string::npos)
+        << launch << "\n" << dump;
+  }
+  const std::string fusion = dumpParams("fusion.launch");
+  EXPECT_NE(fusion.find("/fusion/fusion/unbounded_scale: 1"), std::string::npos) << fusion;
+  const std::string rig = dumpParams("zed_vls128.launch", "preset:=fusion");
+  EXPECT_NE(rig.find("/fusion/fusion/unbounded_scale: 1"), std::string::npos) << rig;
 }

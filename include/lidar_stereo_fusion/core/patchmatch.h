@@ -86,6 +86,12 @@ struct PatchMatchParams {
   /// but not propagated, in the left view only: ~1.4x faster on KITTI, 0.1-0.2 px less precise
   /// where only the images decide (above the LiDAR's field of view).
   bool full_size_unbounded = true;
+  /// The finest level, as its reduction factor, at which the pixels without scan-line bounds are
+  /// searched: 1 = every level (the default); coarse_scale (2) = up to 1/2 size, after which they
+  /// take the 1/2-size plane as it is, with no window (above the LiDAR's field of view, a third
+  /// of a KITTI image and three quarters of its searched pixels); coarse_scale^2 = up to 1/4
+  /// size. The `live` preset's main saving; 1 or a power of coarse_scale up to the coarsest level.
+  int unbounded_scale = 1;
   /// After a coarse start: the pixels without scan-line bounds that the left-right check of the
   /// level below marks inconsistent (occluded or ambiguous) are not searched; each takes the
   /// plane before it in the row, as the hole filling would. At full size the fill replaces them
@@ -93,6 +99,12 @@ struct PatchMatchParams {
   /// own check decides, only the interior of the regions below (the synthetic street's whole
   /// image 359 mm instead of 416, three seeds). false: every such pixel is searched.
   bool skip_inconsistent = true;
+  /// Intermediate levels of the coarse start (the 1/2-size level of three): the right view
+  /// refines its planes at random from +-fine_refine_range, after the left view's planes were
+  /// offered to it, and hands them back to the left view (true, as Bleyer); false: both views
+  /// only propagate there, the right view for the left-right check (about a fifth of PatchMatch
+  /// on KITTI; the sub-pixel step at full size polishes what the LiDAR bounds).
+  bool intermediate_refine = true;
   int fine_iterations = 1;
   double fine_refine_range = 1.0;  ///< [px]
   /// Full-size level of a coarse start only: whether the right view is searched with refinement
@@ -166,6 +178,7 @@ class PatchMatchStereo {
   struct Scratch;
   std::shared_ptr<Scratch> scratch_;
   std::shared_ptr<PatchMatchStereo> coarse_;  ///< the coarse start's solver (coarse_scale > 1)
+  bool intermediate_ = false;  ///< a reduced level of another solver's coarse start
 };
 
 }  // namespace lidar_stereo_fusion

@@ -88,7 +88,9 @@ void visitParamTable(P& p, V&& v) {
   v(ParamName{"coarse_scale", pm}, m.coarse_scale);
   v(ParamName{"coarse_levels", pm}, m.coarse_levels);
   v(ParamName{"full_size_unbounded", pm}, m.full_size_unbounded);
+  v(ParamName{"unbounded_scale", pm}, m.unbounded_scale);
   v(ParamName{"skip_inconsistent", pm}, m.skip_inconsistent);
+  v(ParamName{"intermediate_refine", pm}, m.intermediate_refine);
   v(ParamName{"fine_iterations", pm}, m.fine_iterations);
   v(ParamName{"fine_refine_range", pm}, m.fine_refine_range);
   v(ParamName{"fine_right_view", pm}, m.fine_right_view);

@@ -56,7 +56,9 @@ PatchMatchParams coarseParams(const PatchMatchParams& p) {
   c.lr_check = false;
   c.coarse_levels = std::max(1, p.coarse_levels - 1);
   c.coarse_scale = p.coarse_levels > 1 ? s : 1;
-  c.full_size_unbounded = true;  // the levels below search everything, in both views ...
+  // The levels below search everything, in both views, down to unbounded_scale ...
+  c.unbounded_scale = std::max(1, p.unbounded_scale / s);
+  c.full_size_unbounded = true;
   c.fine_right_view = true;
   c.fine_subpixel = false;       // ... and the sub-pixel step belongs to the full size
   return c;

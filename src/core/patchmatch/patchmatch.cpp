@@ -42,6 +42,17 @@ std::vector<uint8_t> lockedToPrior(const patchmatch::ViewState& v) {
   return keep;
 }
 
+/// Whether `s` is the reduction factor of a level of the coarse start: 1 or coarse_scale^k,
+/// k = 1 .. coarse_levels.
+bool isLevelScale(const PatchMatchParams& p, int s) {
+  if (s == 1) return true;
+  if (p.coarse_scale < 2) return false;
+  for (int k = 1, f = p.coarse_scale; k <= p.coarse_levels; ++k, f *= p.coarse_scale) {
+    if (s == f) return true;
+  }
+  return false;
+}
+
 cv::Mat3f planeMap(const patchmatch::ViewState& v, int threads) {
   cv::Mat3f map(v.height, v.width);
 #pragma omp parallel for schedule(static) num_threads(threads)
@@ -82,6 +93,9 @@ void PatchMatchParams::validate() const {
   require(fill_confidence >= 0 && fill_confidence <= 1, "fill_confidence must be in [0, 1]");
   require(coarse_scale >= 1 && coarse_scale <= 16, "coarse_scale must be in [1, 16] (1 = off)");
   require(coarse_levels >= 1 && coarse_levels <= 4, "coarse_levels must be in [1, 4]");
+  require(isLevelScale(*this, unbounded_scale),
+          "unbounded_scale must be 1 or coarse_scale^k, k = 1 .. coarse_levels (a level's "
+          "reduction factor)");
   require(fine_iterations >= 1 && fine_iterations <= 100, "fine_iterations must be in [1, 100]");
   require(std::isfinite(fine_refine_range) && fine_refine_range > 0,
           "fine_refine_range must be > 0");
@@ -125,7 +139,10 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   cv::Mat1b inconsistent;  // the left-right check's mask, where it is the level below's
   if (guided) {
     // Coarse start: its planes, up-sampled, are where the full-size search begins.
-    if (!coarse_) coarse_ = std::make_shared<PatchMatchStereo>(coarseParams(p));
+    if (!coarse_) {
+      coarse_ = std::make_shared<PatchMatchStereo>(coarseParams(p));
+      coarse_->intermediate_ = true;
+    }
     coarse_->setParams(coarseParams(p));
     ViewInput coarse_left, coarse_right;
     bothViews(threads, [&] { coarse_left = downsampleView(left, p.coarse_scale); },
@@ -176,6 +193,9 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   left_options.subpixel = guided && p.fine_subpixel;
   left_options.refine = !guided || p.fine_refine;
   right_options.refine = !guided || p.fine_right_view;
+  // An intermediate level (1/2 size of three) refines its right view only with
+  // intermediate_refine; else both views only propagate there.
+  if (guided && intermediate_ && !p.intermediate_refine) right_options.refine = false;
   // Swept by propagation alone, the right view serves the left-right check only.
   if (!right_options.refine) right_options.tolerance = 0.25f * static_cast<float>(p.lr_max_diff);
   PlaneSearch left_search(p, lv, rv, left_options);

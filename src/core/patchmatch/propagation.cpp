@@ -37,7 +37,7 @@ void PlaneSearch::initRange(int x, int y, float& lo, float& hi) const {
 Plane PlaneSearch::initialPlane(int x, int y, Rng& rng) const {
   const int idx = y * self_.width + x;
   if (self_.locked[idx] == kLockedToPrior) return priorPlane(self_, x, y);
-  if (self_.locked[idx] == kSettledByGuide ||
+  if (self_.locked[idx] == kSettledByGuide || self_.locked[idx] == kKeptFromGuide ||
       (self_.locked[idx] == kLeftToFill && !self_.guide.empty())) {
     return self_.guide[idx];
   }
@@ -81,7 +81,7 @@ void PlaneSearch::randomNormal(Rng& rng, float& nx, float& ny, float& nz) const 
 void PlaneSearch::processPixel(int x, int y, bool forward, int iteration,
                                WindowCache& cache) const {
   const int idx = y * self_.width + x;
-  if (self_.locked[idx] == kLockedToPrior) return;
+  if (self_.locked[idx] == kLockedToPrior || self_.locked[idx] == kKeptFromGuide) return;
   if (self_.locked[idx] == kSettledByGuide) {
     if (self_.match_sign < 0) polishSettled(x, y, idx, iteration, cache);
     return;

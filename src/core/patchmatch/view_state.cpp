@@ -183,11 +183,16 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
 
 void setGuide(std::vector<Plane> guide, const PatchMatchParams& p, ViewState& v) {
   v.guide = std::move(guide);
-  if (p.full_size_unbounded) return;
+  // A level finer than unbounded_scale takes the level below's plane as it is; else, without
+  // full_size_unbounded, it polishes that plane.
+  const uint8_t settle = p.unbounded_scale > 1    ? kKeptFromGuide
+                         : p.full_size_unbounded ? uint8_t{0}
+                                                 : kSettledByGuide;
+  if (settle == 0) return;
   for (int y = 0; y < v.height; ++y) {
     for (int x = 0; x < v.width; ++x) {
       uint8_t& l = v.locked[y * v.width + x];
-      if (l == 0 && !v.bounded(x, y)) l = kSettledByGuide;
+      if (l == 0 && !v.bounded(x, y)) l = settle;
     }
   }
 }

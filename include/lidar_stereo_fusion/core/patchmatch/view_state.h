@@ -18,6 +18,7 @@ namespace patchmatch {
 constexpr uint8_t kLockedToPrior = 1;
 constexpr uint8_t kSettledByGuide = 2;
 constexpr uint8_t kLeftToFill = 3;
+constexpr uint8_t kKeptFromGuide = 4;
 
 struct ViewState {
   int width = 0, height = 0;
@@ -33,8 +34,9 @@ struct ViewState {
   std::vector<float> cost;
   /// Pixels that are not searched: kLockedToPrior where the plane is the prior's (trust >=
   /// lock_confidence), kSettledByGuide where it is the coarse level's (no scan-line bounds and
-  /// full_size_unbounded false), kLeftToFill where the level below found the pixel
-  /// inconsistent (leaveToFill); 0 elsewhere.
+  /// full_size_unbounded false; polished), kKeptFromGuide where it is the coarse level's as it is
+  /// (no scan-line bounds, at a level finer than unbounded_scale), kLeftToFill where the level
+  /// below found the pixel inconsistent (leaveToFill); 0 elsewhere.
   std::vector<uint8_t> locked;
   /// Planes of the coarse start, up-sampled (empty: none): the initial plane where admissible.
   std::vector<Plane> guide;
