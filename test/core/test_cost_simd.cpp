@@ -434,7 +434,7 @@ TEST(CostSimd, PatchMatchSameOnBothPaths) {
     lsf::PatchMatchParams p;
     p.confidence_weighting = weighted;
     if (variant == 2) {
-      p.unbounded_scale = 2;
+      p.search_scale = 2;
       p.intermediate_refine = false;
     }
     p.num_threads = 2;

@@ -77,6 +77,7 @@ FusionParams everyFieldChanged() {
   m.coarse_levels = 3;
   m.full_size_unbounded = true;
   m.unbounded_scale = 9;  // coarse_scale^2
+  m.search_scale = 3;
   m.skip_inconsistent = false;
   m.intermediate_refine = false;
   m.fine_iterations = 2;
@@ -138,6 +139,7 @@ void expectSame(const FusionParams& a, const FusionParams& b) {
   EXPECT_EQ(x.full_size_unbounded, y.full_size_unbounded);
   EXPECT_EQ(x.skip_inconsistent, y.skip_inconsistent);
   EXPECT_EQ(x.unbounded_scale, y.unbounded_scale);
+  EXPECT_EQ(x.search_scale, y.search_scale);
   EXPECT_EQ(x.intermediate_refine, y.intermediate_refine);
   EXPECT_EQ(x.fine_iterations, y.fine_iterations);
   EXPECT_EQ(x.fine_refine_range, y.fine_refine_range);
@@ -281,10 +283,10 @@ TEST(ParamsYaml, TheLivePresetCutsTheSearchOnly) {
   FusionParams p;
   loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/live.yaml", p);
   EXPECT_EQ(p.method, Method::kFusedBI);
-  EXPECT_EQ(p.patchmatch.unbounded_scale, 2);
+  EXPECT_EQ(p.patchmatch.search_scale, 2);
   EXPECT_FALSE(p.patchmatch.intermediate_refine);
   FusionParams expected;
-  expected.patchmatch.unbounded_scale = 2;
+  expected.patchmatch.search_scale = 2;
   expected.patchmatch.intermediate_refine = false;
   expectSame(p, expected);
 }

@@ -170,7 +170,7 @@ TEST(PatchMatch, DeterministicForSeedAndThreadCount) {
   for (const bool live : {false, true}) {  // the default and the live preset's search
     auto p = stereoOnly();
     if (live) {
-      p.unbounded_scale = 2;
+      p.search_scale = 2;
       p.intermediate_refine = false;
     }
     p.num_threads = 1;
@@ -210,6 +210,11 @@ TEST(PatchMatch, RejectsBadInput) {
   u.unbounded_scale = 2;
   u.coarse_scale = 1;  // no coarse start: no level but full size
   EXPECT_THROW(u.validate(), std::invalid_argument);
+  lsf::PatchMatchParams search;
+  search.search_scale = 3;
+  EXPECT_THROW(search.validate(), std::invalid_argument);
+  search.search_scale = 4;
+  EXPECT_NO_THROW(search.validate());
   lsf::PatchMatchStereo pm;
   cv::Mat a(10, 20, CV_8UC3), b(10, 21, CV_8UC3);
   EXPECT_THROW(pm.compute({a, cv::Mat1f(), {}}, {b, cv::Mat1f(), {}}), std::invalid_argument);

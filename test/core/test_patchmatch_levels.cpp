@@ -172,6 +172,49 @@ TEST(PatchMatchCoarseStart, AtUnboundedScale2StereoOnlyPixelsAreTheHalfSizePlane
   }
 }
 
+TEST(PatchMatchCoarseStart, AtSearchScale2FullSizeUpsamplesTheCheckedAndFilledHalfSizeLevel) {
+  // A slanted plane with a locked prior row: full size does not search. Every pixel is the 1/2
+  // level's plane evaluated at full size, the prior where it is locked, or twice the level's
+  // filled disparity where its left-right check failed.
+  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(96, 48, 0.05, 0.0, 6.0, 4);
+  cv::Mat1f prior = cv::Mat1f::zeros(48, 96), conf = cv::Mat1f::zeros(48, 96);
+  for (int x = 0; x < 96; ++x) {
+    prior(20, x) = static_cast<float>(s.disparity(x, 20));
+    conf(20, x) = 1.f;
+  }
+  lsf::PatchMatchParams p;
+  p.max_disparity = 16;
+  p.search_scale = 2;
+  p.num_threads = 1;
+  const lsf::ViewInput left(s.left, prior, {}, conf), right(s.right);
+  const lsf::PatchMatchResult full = lsf::PatchMatchStereo(p).compute(left, right);
+  const lsf::PatchMatchParams half_params = pm::coarseParams(p);
+  EXPECT_TRUE(half_params.lr_check);  // the level that fills
+  EXPECT_EQ(half_params.lr_max_diff, p.lr_max_diff / 2);
+  EXPECT_EQ(half_params.search_scale, 1);
+  const lsf::PatchMatchResult half = lsf::PatchMatchStereo(half_params)
+                                         .compute(pm::downsampleView(left, 2),
+                                                  pm::downsampleView(right, 2));
+  const std::vector<pm::Plane> up = pm::upsamplePlanes(half.planes, 2, s.left.size());
+  int checked = 0, filled = 0;
+  for (int y = 0; y < 48; ++y) {
+    for (int x = 0; x < 96; ++x) {
+      float expected = up[y * 96 + x].at(static_cast<float>(x), static_cast<float>(y));
+      if (y == 20) {
+        expected = prior(20, x);  // locked
+        EXPECT_EQ(full.inconsistent(y, x), 0);
+      } else if (half.inconsistent(y / 2, x / 2)) {
+        expected = 2.f * half.disparity(y / 2, x / 2);
+        ++filled;
+      }
+      EXPECT_FLOAT_EQ(full.disparity(y, x), std::max(0.f, expected)) << x << ", " << y;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 96 * 48);
+  EXPECT_GT(filled, 0);  // the right border, hidden in the right view
+}
+
 TEST(PatchMatchCoarseStart, InconsistentPixelsWithoutBoundsAreLeftToTheFill) {
   const lsf::PatchMatchParams p = params3x3();
   Views v = guided6x4(p);

@@ -57,13 +57,13 @@ TEST(LaunchFiles, PresetLiveLoadsConfigLiveEverywhere) {
         {"measure_live.launch", "preset:=live"},
         {"zed_vls128.launch", ""}}) {
     const std::string dump = dumpParams(launch, args);
-    EXPECT_NE(dump.find("/fusion/fusion/unbounded_scale: 2"), std::string::npos)
+    EXPECT_NE(dump.find("/fusion/fusion/search_scale: 2"), std::string::npos)
         << launch << "\n" << dump;
     EXPECT_NE(dump.find("/fusion/fusion/intermediate_refine: false"), std::string::npos)
         << launch << "\n" << dump;
   }
   const std::string fusion = dumpParams("fusion.launch");
-  EXPECT_NE(fusion.find("/fusion/fusion/unbounded_scale: 1"), std::string::npos) << fusion;
+  EXPECT_NE(fusion.find("/fusion/fusion/search_scale: 1"), std::string::npos) << fusion;
   const std::string rig = dumpParams("zed_vls128.launch", "preset:=fusion");
-  EXPECT_NE(rig.find("/fusion/fusion/unbounded_scale: 1"), std::string::npos) << rig;
+  EXPECT_NE(rig.find("/fusion/fusion/search_scale: 1"), std::string::npos) << rig;
 }

@@ -99,6 +99,13 @@ struct PatchMatchParams {
   /// own check decides, only the interior of the regions below (the synthetic street's whole
   /// image 359 mm instead of 416, three seeds). false: every such pixel is searched.
   bool skip_inconsistent = true;
+  /// The finest level, as its reduction factor, that searches at all: 1 = full size (the
+  /// default); coarse_scale (2) = the 1/2-size level searches, checks left against right and fills
+  /// its holes, and full size only up-samples its result: planes evaluated at full size, the
+  /// prior's plane where the prior is locked or fills an inconsistent pixel, the level's filled
+  /// disparity (times coarse_scale) on its other inconsistent pixels. 1 or a power of
+  /// coarse_scale up to the coarsest level.
+  int search_scale = 1;
   /// Intermediate levels of the coarse start (the 1/2-size level of three): the right view
   /// refines its planes at random from +-fine_refine_range, after the left view's planes were
   /// offered to it, and hands them back to the left view (true, as Bleyer); false: both views
@@ -179,6 +186,11 @@ class PatchMatchStereo {
   std::shared_ptr<Scratch> scratch_;
   std::shared_ptr<PatchMatchStereo> coarse_;  ///< the coarse start's solver (coarse_scale > 1)
   bool intermediate_ = false;  ///< a reduced level of another solver's coarse start
+
+  /// The coarse start's level below, on the views reduced by coarse_scale.
+  PatchMatchResult levelBelow(const ViewInput& left, const ViewInput& right);
+  /// A level that does not search (search_scale): the level below's result, up-sampled.
+  PatchMatchResult upsampledResult(const ViewInput& left, const ViewInput& right);
 };
 
 }  // namespace lidar_stereo_fusion

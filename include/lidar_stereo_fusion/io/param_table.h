@@ -90,6 +90,7 @@ void visitParamTable(P& p, V&& v) {
   v(ParamName{"full_size_unbounded", pm}, m.full_size_unbounded);
   v(ParamName{"unbounded_scale", pm}, m.unbounded_scale);
   v(ParamName{"skip_inconsistent", pm}, m.skip_inconsistent);
+  v(ParamName{"search_scale", pm}, m.search_scale);
   v(ParamName{"intermediate_refine", pm}, m.intermediate_refine);
   v(ParamName{"fine_iterations", pm}, m.fine_iterations);
   v(ParamName{"fine_refine_range", pm}, m.fine_refine_range);

@@ -53,7 +53,11 @@ PatchMatchParams coarseParams(const PatchMatchParams& p) {
   c.min_disparity = p.min_disparity / s;
   c.max_disparity = p.max_disparity / s;
   c.min_refine_range = p.min_refine_range / s;
-  c.lr_check = false;
+  // No left-right check below full size, but on the finest level that searches (search_scale),
+  // whose filled result the levels above up-sample; at lr_max_diff in full-size px.
+  c.search_scale = std::max(1, p.search_scale / s);
+  c.lr_check = p.lr_check && p.search_scale >= s;
+  if (c.lr_check) c.lr_max_diff = p.lr_max_diff / s;
   c.coarse_levels = std::max(1, p.coarse_levels - 1);
   c.coarse_scale = p.coarse_levels > 1 ? s : 1;
   // The levels below search everything, in both views, down to unbounded_scale ...

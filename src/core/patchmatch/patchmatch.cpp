@@ -93,6 +93,9 @@ void PatchMatchParams::validate() const {
   require(fill_confidence >= 0 && fill_confidence <= 1, "fill_confidence must be in [0, 1]");
   require(coarse_scale >= 1 && coarse_scale <= 16, "coarse_scale must be in [1, 16] (1 = off)");
   require(coarse_levels >= 1 && coarse_levels <= 4, "coarse_levels must be in [1, 4]");
+  require(isLevelScale(*this, search_scale),
+          "search_scale must be 1 or coarse_scale^k, k = 1 .. coarse_levels (a level's "
+          "reduction factor)");
   require(isLevelScale(*this, unbounded_scale),
           "unbounded_scale must be 1 or coarse_scale^k, k = 1 .. coarse_levels (a level's "
           "reduction factor)");
@@ -116,6 +119,58 @@ void PatchMatchStereo::setParams(const PatchMatchParams& params) {
   params_ = params;
 }
 
+PatchMatchResult PatchMatchStereo::levelBelow(const ViewInput& left, const ViewInput& right) {
+  const PatchMatchParams& p = params_;
+  if (!coarse_) {
+    coarse_ = std::make_shared<PatchMatchStereo>(patchmatch::coarseParams(p));
+    coarse_->intermediate_ = true;
+  }
+  coarse_->setParams(patchmatch::coarseParams(p));
+  ViewInput coarse_left, coarse_right;
+  bothViews(patchmatch::threadCount(p),
+            [&] { coarse_left = patchmatch::downsampleView(left, p.coarse_scale); },
+            [&] { coarse_right = patchmatch::downsampleView(right, p.coarse_scale); });
+  return coarse_->compute(coarse_left, coarse_right);
+}
+
+PatchMatchResult PatchMatchStereo::upsampledResult(const ViewInput& left, const ViewInput& right) {
+  using namespace patchmatch;
+  const PatchMatchParams& p = params_;
+  const int threads = threadCount(p);
+  const cv::Size size = left.image.size();
+  ViewState& lv = scratch_->left;
+  preparePrior(left, p, lv);  // the images are the level below's alone
+  const PatchMatchResult below = levelBelow(left, right);
+  const int s = p.coarse_scale;
+  lv.planes = upsamplePlanes(below.planes, s, size, threads);
+  PatchMatchResult result;
+  result.planes.create(size);
+  result.disparity.create(size);
+  result.inconsistent = p.lr_check ? upsampleMask(below.inconsistent, s, size)
+                                   : cv::Mat1b(size, uchar(0));
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const int idx = y * size.width + x;
+      Plane& plane = lv.planes[idx];
+      if (lv.locked[idx] == kLockedToPrior) {
+        plane = priorPlane(lv, x, y);
+        result.inconsistent(y, x) = 0;  // the LiDAR measured it: the check keeps it
+      }
+      result.planes(y, x) = cv::Vec3f(plane.a, plane.b, plane.c);
+      result.disparity(y, x) = plane.at(static_cast<float>(x), static_cast<float>(y));
+    }
+  }
+  if (p.lr_check) {
+    fillFromBelow(lv, result.inconsistent.clone(), below.disparity, s,
+                  static_cast<float>(p.fill_confidence), result.disparity, threads);
+  }
+  for (float& d : result.disparity) {
+    if (!(d > 0.f) || !std::isfinite(d)) d = 0.f;
+  }
+  return result;
+}
+
 PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInput& right) {
   using namespace patchmatch;
   const cv::Size size = left.image.size();
@@ -123,6 +178,8 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   checkViewInput(right, size, "right");
   const PatchMatchParams& p = params_;
   if (!scratch_) scratch_ = std::make_shared<Scratch>();
+  const bool guided = p.coarse_scale > 1 && std::min(size.width, size.height) >= 4 * p.coarse_scale;
+  if (guided && p.search_scale > 1) return upsampledResult(left, right);
   ViewState& lv = scratch_->left;
   ViewState& rv = scratch_->right;
   const int threads = threadCount(p);
@@ -132,22 +189,13 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
 
   int iterations = p.iterations;
   const bool unmatched_bad = p.confidence_weighting && !lv.prior.empty();
-  const bool guided = p.coarse_scale > 1 && std::min(size.width, size.height) >= 4 * p.coarse_scale;
   // Whether the full-size right view is searched: without a coarse start always; after one for
   // Bleyer's right view (fine_right_view) or a full-size left-right check (fine_lr_check).
   bool right_view = two_views && (!guided || p.fine_right_view || (p.lr_check && p.fine_lr_check));
   cv::Mat1b inconsistent;  // the left-right check's mask, where it is the level below's
   if (guided) {
     // Coarse start: its planes, up-sampled, are where the full-size search begins.
-    if (!coarse_) {
-      coarse_ = std::make_shared<PatchMatchStereo>(coarseParams(p));
-      coarse_->intermediate_ = true;
-    }
-    coarse_->setParams(coarseParams(p));
-    ViewInput coarse_left, coarse_right;
-    bothViews(threads, [&] { coarse_left = downsampleView(left, p.coarse_scale); },
-              [&] { coarse_right = downsampleView(right, p.coarse_scale); });
-    const PatchMatchResult coarse = coarse_->compute(coarse_left, coarse_right);
+    const PatchMatchResult coarse = levelBelow(left, right);
     setGuide(upsamplePlanes(coarse.planes, p.coarse_scale, size, threads), p, lv);
     // The coarse level has no left-right check, so without view propagation it has no right view.
     if (right_view && !coarse.right_planes.empty()) {

@@ -78,6 +78,25 @@ cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float ma
   return bad;
 }
 
+void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, int scale,
+                   float fill_trust, cv::Mat1f& disparity, int threads) {
+  const bool has_prior = !v.prior.empty();
+  const float s = static_cast<float>(scale);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* below_row = below[std::min(below.rows - 1, y / scale)];
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (!bad(y, x)) continue;
+      if (has_prior && v.prior(y, x) > 0.f && v.trust(y, x) >= fill_trust) {
+        disparity(y, x) = v.prior(y, x);
+        bad(y, x) = 0;
+      } else {
+        disparity(y, x) = s * below_row[std::min(below.cols - 1, x / scale)];
+      }
+    }
+  }
+}
+
 void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float fill_trust,
                float max_disparity, cv::Mat1f& disparity, int threads) {
   if (!v.prior.empty()) {

@@ -158,21 +158,27 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
   cv::Mat1f gx, gy;
   prepareImages(in, p.image_smoothing, p.beta > 0, v, gx, gy);
   prepareTexels(gx, gy, v);
+  preparePrior(in, p, v);
+  const size_t n = static_cast<size_t>(v.width) * v.height;
+  // Planes, costs and offers are written before they are read (initialise, offerView): the
+  // previous frame's buffers are reused as they are; flags start cleared.
+  v.planes.resize(n);
+  v.cost.resize(n);
+  v.offer.resize(n);
+  v.offered.assign(n, 0);
+  v.guide.clear();
+}
+
+void preparePrior(const ViewInput& in, const PatchMatchParams& p, ViewState& v) {
+  v.width = in.image.cols;
+  v.height = in.image.rows;
   v.prior = in.prior;
   prepareTrust(in, p, v);
   v.lo = in.bounds.lo;
   v.hi = in.bounds.hi;
   v.range = in.bounds.range;
   imageRange(in, p, v.d_min, v.d_max);
-  const size_t n = static_cast<size_t>(v.width) * v.height;
-  // Planes, costs and offers are written before they are read (initialise, offerView): the
-  // previous frame's buffers are reused as they are; flags start cleared.
-  v.planes.resize(n);
-  v.cost.resize(n);
-  v.locked.assign(n, 0);
-  v.offer.resize(n);
-  v.offered.assign(n, 0);
-  v.guide.clear();
+  v.locked.assign(static_cast<size_t>(v.width) * v.height, 0);
   const float lock = static_cast<float>(p.lock_confidence);
   if (v.trust.empty() || !p.confidence_weighting || lock > 1.f) return;
   for (int y = 0; y < v.height; ++y) {

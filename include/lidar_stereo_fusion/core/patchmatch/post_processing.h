@@ -23,6 +23,13 @@ cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float ma
                          const std::vector<uint8_t>& keep, bool unmatched_bad = false,
                          int threads = 1);
 
+/// Fills the pixels marked in `bad` (modified) from a level below that checked and filled its
+/// own (PatchMatchParams::search_scale): where the view's prior has a value and its
+/// trust is >= fill_trust, the prior (as fillHoles); elsewhere `scale` times the level below's
+/// disparity at (x / scale, y / scale).
+void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, int scale,
+                   float fill_trust, cv::Mat1f& disparity, int threads = 1);
+
 /// Fills the pixels marked in `bad` (modified). Where the view's prior has a value and its trust
 /// is >= fill_trust, the prior fills the hole (the LiDAR saw the point: our reading for the fused
 /// method; Bleyer's background fill assumes no other source). Elsewhere the lower (background)

@@ -58,6 +58,10 @@ struct ViewState {
 /// Fills `v` from one view's input (reusing its buffers). match_sign: -1 left, +1 right.
 void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sign, ViewState& v);
 
+/// The part of prepareView that needs no image: size, prior, trust, bounds, the image's range and
+/// the pixels locked to the prior (a level that does not search, PatchMatchParams::search_scale).
+void preparePrior(const ViewInput& in, const PatchMatchParams& p, ViewState& v);
+
 /// Sets the coarse level's planes as `v`'s guide and, unless full_size_unbounded, settles the
 /// pixels without scan-line bounds that are not locked to the prior: they keep the guide's plane.
 void setGuide(std::vector<Plane> guide, const PatchMatchParams& p, ViewState& v);
