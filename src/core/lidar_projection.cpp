@@ -81,7 +81,10 @@ SparseDisparity projectCloud(const LidarCloud& cloud, const Eigen::Isometry3d& T
   const bool right = view == View::kRight;
 
   for (const LidarPoint& point : cloud) {
-    if (!isFinite(point)) continue;
+    if (!isFinite(point)) {
+      ++out.points_not_finite;
+      continue;
+    }
     const Eigen::Vector3d p = R * Eigen::Vector3d(point.x, point.y, point.z) + t;
     const double z = p.z();
     if (z < params.min_depth || z > params.max_depth) continue;

@@ -158,9 +158,15 @@ FusionResult FusionPipeline::process(const FusionInput& input) {
     project(View::kLeft, left_sparse);
   }
   if (usesLidar(method) && left_sparse.points_in_image == 0) {
+    const std::size_t points = input.cloud.size();
+    if (points > 0 && static_cast<std::size_t>(left_sparse.points_not_finite) == points) {
+      throw std::invalid_argument("none of the " + std::to_string(points) +
+                                  " LiDAR points is finite (x, y or z NaN / inf): check the sweep");
+    }
     throw std::invalid_argument(
-        "no LiDAR points land in the image (" + std::to_string(input.cloud.size()) +
-        " points, " + std::to_string(left_sparse.points_in_front) +
+        "no LiDAR points land in the image (" + std::to_string(points) + " points, " +
+        std::to_string(left_sparse.points_not_finite) + " of them not finite, " +
+        std::to_string(left_sparse.points_in_front) +
         " in front of the camera): check the cloud and the LiDAR->camera transform");
   }
   const double projection_ms = msSince(t);

@@ -93,7 +93,8 @@ cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg) {
 
 void stereoPairToCore(const sensor_msgs::ImageConstPtr& left,
                       const sensor_msgs::ImageConstPtr& right, cv::Mat& left_out,
-                      cv::Mat& right_out) {
+                      cv::Mat& right_out, std::string* note) {
+  if (note != nullptr) note->clear();
   if (left->width != right->width || left->height != right->height) {
     std::ostringstream s;
     s << "left image is " << left->width << "x" << left->height << " but right image is "
@@ -102,9 +103,15 @@ void stereoPairToCore(const sensor_msgs::ImageConstPtr& left,
   }
   left_out = imageToCore(left);
   right_out = imageToCore(right);
-  if (left_out.type() != right_out.type()) {  // one mono8, one colour: both to BGR
-    if (left_out.channels() == 1) cv::cvtColor(left_out, left_out, cv::COLOR_GRAY2BGR);
-    if (right_out.channels() == 1) cv::cvtColor(right_out, right_out, cv::COLOR_GRAY2BGR);
+  if (left_out.type() != right_out.type()) {  // one mono8, one colour: both grey
+    // Grey replicated into three channels would be matched against real colours; the colour
+    // view's grey is what the mono camera would have seen.
+    if (left_out.channels() == 3) cv::cvtColor(left_out, left_out, cv::COLOR_BGR2GRAY);
+    if (right_out.channels() == 3) cv::cvtColor(right_out, right_out, cv::COLOR_BGR2GRAY);
+    if (note != nullptr) {
+      *note = "left image is " + left->encoding + " but right image is " + right->encoding +
+              ": both views are matched as grey (publish one encoding to match colours)";
+    }
   }
 }
 
@@ -114,27 +121,29 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
   const auto& Pr = right.P;
   for (std::size_t i : {0u, 2u, 3u, 5u, 6u}) {  // the entries used below, of both cameras
     if (!std::isfinite(Pl[i]) || !std::isfinite(Pr[i])) {
-      throw ConversionError(std::string(std::isfinite(Pl[i]) ? "right" : "left") +
-                            " camera_info: P[" + std::to_string(i) + "] is " +
-                            std::to_string(std::isfinite(Pl[i]) ? Pr[i] : Pl[i]) +
-                            " (not finite); is the camera calibrated?");
+      throw CameraInfoError(!std::isfinite(Pl[i]),
+                            std::string(std::isfinite(Pl[i]) ? "right" : "left") +
+                                " camera_info: P[" + std::to_string(i) + "] is " +
+                                std::to_string(std::isfinite(Pl[i]) ? Pr[i] : Pl[i]) +
+                                " (not finite); is the camera calibrated?");
     }
   }
   if (Pl[0] <= 0.0 || Pl[5] <= 0.0) {
-    throw ConversionError("left camera_info: P has no focal length (fx = " + std::to_string(Pl[0]) +
-                          ", fy = " + std::to_string(Pl[5]) + "); is the camera calibrated?");
+    throw CameraInfoError(true, "left camera_info: P has no focal length (fx = " +
+                                    std::to_string(Pl[0]) + ", fy = " + std::to_string(Pl[5]) +
+                                    "); is the camera calibrated?");
   }
   if (Pr[0] <= 0.0) {
-    throw ConversionError("right camera_info: P has no focal length (fx = " +
-                          std::to_string(Pr[0]) + "); is the camera calibrated?");
+    throw CameraInfoError(false, "right camera_info: P has no focal length (fx = " +
+                                     std::to_string(Pr[0]) + "); is the camera calibrated?");
   }
   if (std::abs(Pl[0] - Pr[0]) > 1e-3 * Pl[0] || std::abs(Pl[5] - Pr[5]) > 1e-3 * Pl[5]) {
-    throw ConversionError("left and right camera_info P differ in focal length (fx " +
+    throw CameraInfoError(false, "left and right camera_info P differ in focal length (fx " +
                           std::to_string(Pl[0]) + " vs " + std::to_string(Pr[0]) +
                           "): images are not rectified to a common camera");
   }
   if (left.width != right.width || left.height != right.height) {
-    throw ConversionError("left camera_info is " + std::to_string(left.width) + "x" +
+    throw CameraInfoError(false, "left camera_info is " + std::to_string(left.width) + "x" +
                           std::to_string(left.height) + " but right camera_info is " +
                           std::to_string(right.width) + "x" + std::to_string(right.height));
   }
@@ -149,14 +158,14 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
   camera.width = static_cast<int>(left.width);
   camera.height = static_cast<int>(left.height);
   if (!(camera.baseline > 0.0) || !std::isfinite(camera.baseline)) {
-    throw ConversionError(
-        "right camera_info: P[3] (Tx = -fx * baseline) is " + std::to_string(Pr[3]) +
+    throw CameraInfoError(
+        false, "right camera_info: P[3] (Tx = -fx * baseline) is " + std::to_string(Pr[3]) +
         ", equal to the left one: no baseline (is this the right camera's info?)");
   }
   const std::string implausible = baselinePlausibilityProblem(camera.baseline);
   if (!implausible.empty()) {
-    throw ConversionError("right camera_info: P[3] = " + std::to_string(Pr[3]) + " gives a " +
-                          implausible);
+    throw CameraInfoError(false, "right camera_info: P[3] = " + std::to_string(Pr[3]) +
+                                     " gives a " + implausible);
   }
   return camera;
 }
@@ -184,6 +193,20 @@ int datatypeSize(uint8_t datatype) {
       return 8;
     default:
       return 0;
+  }
+}
+
+const char* datatypeName(uint8_t datatype) {
+  switch (datatype) {
+    case PointField::INT8: return "INT8";
+    case PointField::UINT8: return "UINT8";
+    case PointField::INT16: return "INT16";
+    case PointField::UINT16: return "UINT16";
+    case PointField::INT32: return "INT32";
+    case PointField::UINT32: return "UINT32";
+    case PointField::FLOAT32: return "FLOAT32";
+    case PointField::FLOAT64: return "FLOAT64";
+    default: return "unknown";
   }
 }
 
@@ -263,13 +286,26 @@ std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg) {
   }
   for (const auto& f : msg.fields) {
     const int size = datatypeSize(f.datatype);
+    const bool coordinate = f.name == "x" || f.name == "y" || f.name == "z";
+    const bool read = coordinate || f.name == "intensity" || f.name == "ring" || f.name == "time";
     if (size == 0) {
-      if (f.name == "x" || f.name == "y" || f.name == "z" || f.name == "intensity" ||
-          f.name == "ring" || f.name == "time") {
+      if (read) {
         problem << "field '" << f.name << "' has unknown datatype " << static_cast<int>(f.datatype);
         return problem.str();
       }
       continue;
+    }
+    // A coordinate stored as an integer is not metres (a UINT8 'x' put 95,129 points in front of
+    // the camera instead of 55,058): refused, as is a field holding other than one value.
+    if (coordinate && f.datatype != PointField::FLOAT32 && f.datatype != PointField::FLOAT64) {
+      problem << "field '" << f.name << "' is " << datatypeName(f.datatype) << " (datatype "
+              << static_cast<int>(f.datatype) << "): coordinates must be FLOAT32 or FLOAT64 [m]";
+      return problem.str();
+    }
+    if (read && f.count != 1) {
+      problem << "field '" << f.name << "' has count " << f.count << " ("
+              << datatypeName(f.datatype) << "): one value per point is read";
+      return problem.str();
     }
     // 64-bit sum: an offset near 2^32 must not wrap round and pass.
     if (static_cast<uint64_t>(f.offset) + static_cast<uint64_t>(size) > msg.point_step) {
@@ -317,6 +353,11 @@ CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg) {
       point.z = static_cast<float>(readField(p + fz.offset, fz.datatype));
       if (!std::isfinite(point.x) || !std::isfinite(point.y) || !std::isfinite(point.z)) {
         ++out.non_finite;
+        continue;
+      }
+      if (std::abs(point.x) > kMaxCoordinate || std::abs(point.y) > kMaxCoordinate ||
+          std::abs(point.z) > kMaxCoordinate) {
+        ++out.implausible;
         continue;
       }
       if (fi.present) point.intensity = static_cast<float>(readField(p + fi.offset, fi.datatype));

@@ -69,7 +69,9 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
   ROS_INFO_STREAM("[" << name_ << "] method " << methodName(params_.method) << ", "
                       << (node_params_.approximate_sync ? "approximate" : "exact")
                       << " image sync, sweeps matched within " << node_params_.max_time_offset
-                      << " s; waiting for subscribers on the outputs");
+                      << " s; waiting for a subscriber on the outputs (e.g. "
+                      << topicName("depth/image_rect")
+                      << "), then subscribing to the inputs " << gate_.inputTopics());
 }
 
 FusionWorker::~FusionWorker() {
@@ -172,8 +174,9 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
 
   const auto conversion_start = std::chrono::steady_clock::now();
   conversions::CloudConversion cloud;
+  std::string pair_note;
   try {
-    conversions::stereoPairToCore(set.left, set.right, input.left, input.right);
+    conversions::stereoPairToCore(set.left, set.right, input.left, input.right, &pair_note);
     input.camera = conversions::stereoCameraFromInfo(*set.left_info, *set.right_info);
     cloud = conversions::cloudFromMsg(cloud_msg);
   } catch (const std::exception& e) {  // ConversionError, and anything OpenCV lets through
@@ -183,12 +186,18 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
                   "; frame skipped");
     return;
   }
+  if (!pair_note.empty() && pair_note != mixed_encodings_said_) {  // said once per pair of encodings
+    ROS_WARN_STREAM("[" << name_ << "] " << pair_note);
+    mixed_encodings_said_ = pair_note;
+  }
   if (cloud.cloud.empty()) {
     ++counters_.invalid;
     log_.warn(kCloud, "nan",
               topicName(kCloud) + ": none of the " + std::to_string(cloud.total_points) +
                   " points of the sweep at " + stampText(match.sweep_stamp) +
-                  " is finite (all NaN / inf); frame skipped");
+                  " is finite and within 10 km (" +
+                  std::to_string(cloud.non_finite) + " NaN / inf, " +
+                  std::to_string(cloud.implausible) + " beyond 10 km); frame skipped");
     return;
   }
   FrameReport report;
@@ -205,6 +214,7 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   }
   input.cloud = std::move(cloud.cloud);
   report.cloud_points = static_cast<int>(input.cloud.size());
+  report.invalid_points = cloud.non_finite + cloud.implausible;
   report.conversion_ms = msSince(conversion_start);
 
   FusionResult result;

@@ -40,8 +40,8 @@ boost::optional<Rejection> checkImageSet(const ImageSet& set) {
   }
   try {
     conversions::stereoCameraFromInfo(*set.left_info, *set.right_info);
-  } catch (const conversions::ConversionError& e) {
-    return Rejection{kRightInfo, "calibration", e.what()};
+  } catch (const conversions::CameraInfoError& e) {
+    return Rejection{e.left ? kLeftInfo : kRightInfo, "calibration", e.what()};
   }
   if (set.left->header.frame_id.empty()) {
     return Rejection{kLeftImage, "frame_id",
@@ -110,15 +110,22 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
   // Every input topic's arrivals, for the watch (indices as in watch_'s list); the cloud's in
   // cloudCb.
   sub_left_image_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
-      [this](const auto&) { watch_.heard(0); }));
+      [this](const auto&) { watch_.heard(0, watchNow()); }));
   sub_left_info_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
-      [this](const auto&) { watch_.heard(1); }));
+      [this](const auto&) { watch_.heard(1, watchNow()); }));
   sub_right_image_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
-      [this](const auto&) { watch_.heard(2); }));
+      [this](const auto&) { watch_.heard(2, watchNow()); }));
   sub_right_info_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
-      [this](const auto&) { watch_.heard(3); }));
+      [this](const auto&) { watch_.heard(3, watchNow()); }));
   if (params_.input_timeout > 0.0) {
     watch_timer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
+      if (ros::Time::isSimTime()) {
+        // Silence is measured in ROS time: a slowed bag is not silent between its frames, and a
+        // bag at its end (time stopped) is not a driver gone missing. Before the first clock
+        // message there is no time to measure; the watch starts from the first known time.
+        if (ros::Time::now().isZero()) return;
+        if (!watch_clock_started_.exchange(true)) watch_.start(watchNow());
+      }
       watch_.check([this](std::size_t i) -> uint32_t {
         switch (i) {
           case 0:
@@ -151,7 +158,7 @@ void InputGate::subscribe() {
   sub_right_info_.subscribe(nh_, kRightInfo, q);
   sub_cloud_ = nh_.subscribe(kCloud, 2, &InputGate::cloudCb, this);
   subscribed_ = true;
-  watch_.start();
+  watch_.start(watchNow());
   ROS_DEBUG_STREAM("[" << log_.name() << "] subscribed to the inputs");
 }
 
@@ -213,6 +220,11 @@ void InputGate::waitForFresher(std::unique_lock<std::mutex>& lock) {
 }
 
 void InputGate::reject(const Rejection& r, const ros::Time& stamp, const char* what_skipped) {
+  if (r.topic == kCloud) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    refused_sweep_stamp_ = stamp;
+    refused_sweep_problem_ = r.problem;
+  }
   ++counters_.invalid;
   log_.warn(r.topic, r.kind,
             topicName(r.topic) + ": " + r.problem + " (stamp " + stampText(stamp) + "); " +
@@ -226,11 +238,57 @@ void InputGate::detectClockJump() {
   if (!last_clock_.isZero() && now + ros::Duration(0.5) < last_clock_) {
     counters_.dropped += static_cast<uint32_t>(matcher_.clear());
     ++clock_epoch_;
+    restarted(now);
+    if (subscribed_) watch_.start(watchNow());  // its times are ROS times under sim time
     log_.log(ThrottledLog::Level::kInfo, "clock", "jump",
              "ROS time jumped back from " + stampText(last_clock_) + " to " + stampText(now) +
                  ": sweep and image buffers cleared (bag loop?)");
   }
   last_clock_ = now;
+}
+
+InputWatch::Clock::time_point InputGate::watchNow() {
+  if (!ros::Time::isSimTime()) return InputWatch::Clock::now();
+  return InputWatch::Clock::time_point(std::chrono::nanoseconds(ros::Time::now().toNSec()));
+}
+
+void InputGate::restarted(const ros::Time& now) {
+  // The sets in flight when time restarts lose their partners (the synchroniser's queue, the
+  // sweep buffer): for a moment, a lost set is the restart's doing, not the rig's.
+  restart_grace_until_ =
+      now + ros::Duration(1.0 + params_.max_sweep_wait + params_.max_time_offset);
+}
+
+std::string InputGate::inputTopics() const {
+  return topicName(kLeftImage) + ", " + topicName(kLeftInfo) + ", " + topicName(kRightImage) +
+         ", " + topicName(kRightInfo) + ", " + topicName(kCloud);
+}
+
+bool InputGate::sweepRefusedNear(const ros::Time& image_stamp) const {
+  return !refused_sweep_stamp_.isZero() &&
+         std::abs((refused_sweep_stamp_ - image_stamp).toSec()) <=
+             params_.max_time_offset + params_.max_sweep_wait;
+}
+
+std::string InputGate::noSweepText(const ros::Time& image_stamp, bool waited) const {
+  const std::string at = stampText(image_stamp);
+  if (sweepRefusedNear(image_stamp)) {
+    // The LiDAR is publishing: its sweep was refused (already warned about, with the reason).
+    return "no usable sweep on " + topicName(kCloud) + " for the image set at " + at +
+           ": the sweep at " + stampText(refused_sweep_stamp_) + " was refused (" +
+           refused_sweep_problem_ + "); image set skipped";
+  }
+  if (waited) {  // no sweep at or after the set came in time
+    return "no sweep on " + topicName(kCloud) + " stamped at or after the image set at " + at +
+           " arrived within ~max_sweep_wait = " + std::to_string(params_.max_sweep_wait) +
+           " s (ROS time), and none before it within ~max_time_offset = " +
+           std::to_string(params_.max_time_offset) +
+           " s; image set skipped (is the LiDAR publishing? raise ~max_sweep_wait if its sweeps "
+           "arrive late)";
+  }
+  return "no sweep on " + topicName(kCloud) + " within ~max_time_offset = " +
+         std::to_string(params_.max_time_offset) + " s of the image set at " + at +
+         "; image set skipped (raise ~max_time_offset if the clocks differ)";
 }
 
 void InputGate::imageCb(const sensor_msgs::ImageConstPtr& left,
@@ -268,6 +326,12 @@ void InputGate::syncDropCb(const sensor_msgs::ImageConstPtr& left,
                            const sensor_msgs::CameraInfoConstPtr& right_info) {
   // ExactTime gave up on an incomplete set (a partner message never came with the same stamp).
   ++counters_.unmatched;
+  bool restart;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    detectClockJump();  // the synchroniser may give up on a set before any callback saw the jump
+    restart = inRestartGrace();
+  }
   std::string missing;
   if (!left) missing += std::string(" ") + topicName(kLeftImage);
   if (!left_info) missing += std::string(" ") + topicName(kLeftInfo);
@@ -282,6 +346,13 @@ void InputGate::syncDropCb(const sensor_msgs::ImageConstPtr& left,
     stamp = left_info->header.stamp;
   else if (right_info)
     stamp = right_info->header.stamp;
+  if (restart) {
+    log_.log(ThrottledLog::Level::kInfo, "image set", "restart",
+             "incomplete image set at stamp " + stampText(stamp) +
+                 " dropped by the exact-time synchroniser as time restarted (bag loop); missing:" +
+                 missing);
+    return;
+  }
   log_.warn("image set", "incomplete",
             "incomplete image set at stamp " + stampText(stamp) +
                 " dropped by the exact-time synchroniser; missing:" + missing +
@@ -289,7 +360,7 @@ void InputGate::syncDropCb(const sensor_msgs::ImageConstPtr& left,
 }
 
 void InputGate::cloudCb(const sensor_msgs::PointCloud2ConstPtr& cloud) {
-  watch_.heard(4);
+  watch_.heard(4, watchNow());
   const ros::Time stamp = cloud->header.stamp;
   ROS_DEBUG_STREAM("[" << log_.name() << "] sweep " << stampText(stamp) << " ("
                        << static_cast<uint64_t>(cloud->width) * cloud->height << " points)");
@@ -305,6 +376,7 @@ void InputGate::handleEvents(InputMatcher::Events& events, const std::string& to
   if (events.restarted) {
     counters_.dropped += static_cast<uint32_t>(events.discarded);
     ++clock_epoch_;
+    restarted(ros::Time::now());
     fresh_.clear();
     std::ostringstream text;
     text << topicName(topic) << ": stamp " << stampText(stamp) << " is more than "
@@ -321,21 +393,16 @@ void InputGate::handleEvents(InputMatcher::Events& events, const std::string& to
   }
   for (std::size_t i = 0; i < events.unmatched.size(); ++i) {
     ++counters_.unmatched;
-    const std::string at = stampText(events.unmatched[i]);
-    if (events.unmatched_waited[i]) {  // no sweep at or after the set came in time
-      log_.warn(kCloud, "late",
-                "no sweep on " + topicName(kCloud) + " stamped at or after the image set at " + at +
-                    " arrived within ~max_sweep_wait = " + std::to_string(params_.max_sweep_wait) +
-                    " s (ROS time), and none before it within ~max_time_offset = " +
-                    std::to_string(params_.max_time_offset) +
-                    " s; image set skipped (is the LiDAR publishing? raise ~max_sweep_wait if its "
-                    "sweeps arrive late)");
-    } else {
-      log_.warn(kCloud, "unmatched",
-                "no sweep on " + topicName(kCloud) + " within ~max_time_offset = " +
-                    std::to_string(params_.max_time_offset) + " s of the image set at " + at +
-                    "; image set skipped (raise ~max_time_offset if the clocks differ)");
+    if (inRestartGrace()) {
+      log_.log(ThrottledLog::Level::kInfo, kCloud, "restart",
+               "image set at " + stampText(events.unmatched[i]) +
+                   " skipped: time restarted (bag loop) before its sweep came");
+      continue;
     }
+    const char* kind = sweepRefusedNear(events.unmatched[i]) ? "refused"
+                       : events.unmatched_waited[i]             ? "late"
+                                                                : "unmatched";
+    log_.warn(kCloud, kind, noSweepText(events.unmatched[i], events.unmatched_waited[i]));
   }
   if (events.ready.empty()) return;
   ROS_DEBUG_STREAM("[" << log_.name() << "] matched image set "

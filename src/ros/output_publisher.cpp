@@ -45,6 +45,7 @@ FusionStatsPtr makeStatsMsg(const std_msgs::Header& header, const FrameStats& s,
   msg->latency_ms = static_cast<float>(latency_ms);
   msg->sweep_time_offset = static_cast<float>(sweep_time_offset);
   msg->points_in_cloud = report.cloud_points;
+  msg->points_invalid = report.invalid_points;
   msg->points_in_front = s.points_in_front;
   msg->points_projected = s.points_projected;
   msg->points_removed = s.points_removed;

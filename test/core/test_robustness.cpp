@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -82,6 +83,44 @@ TEST(Robustness, ImplausibleBaselineNamesTheValueAndTheUnitMistake) {
   EXPECT_NE(mm.find("0.537"), std::string::npos) << mm;
   EXPECT_NE(baselinePlausibilityProblem(0.0005), "");
   EXPECT_NE(baselinePlausibilityProblem(std::nan("")), "");
+}
+
+// Issue 25, point 7: an all-NaN sweep (a corrupt .bin) is named as not finite, not as landing
+// outside the image; and the count of non-finite points is in the message otherwise.
+TEST(Robustness, AnAllNanSweepIsNamedAsNotFinite) {
+  FusionInput input;
+  input.left = cv::Mat(40, 60, CV_8UC3, cv::Scalar(80, 90, 100));
+  input.right = input.left.clone();
+  input.camera.fx = input.camera.fy = 50.0;
+  input.camera.cx = 30.0;
+  input.camera.cy = 20.0;
+  input.camera.baseline = 0.5;
+  input.camera.width = 60;
+  input.camera.height = 40;
+  input.T_cam_lidar = Eigen::Isometry3d::Identity();
+  LidarPoint nan_point;
+  nan_point.x = nan_point.y = nan_point.z = std::numeric_limits<float>::quiet_NaN();
+  input.cloud.assign(1000, nan_point);
+  FusionPipeline pipeline{FusionParams()};
+  try {
+    pipeline.process(input);
+    FAIL() << "an all-NaN sweep was processed";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("none of the 1000 LiDAR points is finite"),
+              std::string::npos)
+        << e.what();
+  }
+  LidarPoint behind;  // finite, behind the camera
+  behind.z = -5.f;
+  input.cloud.push_back(behind);
+  try {
+    pipeline.process(input);
+    FAIL() << "a sweep with no point in the image was processed";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("(1001 points, 1000 of them not finite, 0 in front"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 /// `lasers` lasers stored laser by laser as in a KITTI .bin (ring 0 the highest), `per_laser`

@@ -50,6 +50,7 @@ struct SetSpec {
   bool cloud_first = false;         ///< publish the sweep before the images
   bool positive_tx = false;         ///< right camera_info with Tx = +fx * B
   double right_stamp_offset = 0.0;  ///< right image/info stamp - left stamp [s]
+  bool left_info_zero = false;      ///< left camera_info with all-zero K and P
 };
 
 class Harness {
@@ -146,6 +147,10 @@ class Harness {
     }
     auto right = lsf::test::imageMsg(right_bgr, spec.right_encoding, right_frame_, right_stamp);
     auto linfo = lsf::test::cameraInfoMsg(frame.camera, false, kCameraFrame, stamp);
+    if (spec.left_info_zero) {
+      linfo->K.fill(0.0);
+      linfo->P.fill(0.0);
+    }
     auto rinfo =
         lsf::test::cameraInfoMsg(right_camera, true, right_frame_, right_stamp, spec.positive_tx);
     auto cloud = makeCloud(spec, stamp);

@@ -21,6 +21,9 @@
 #include <thread>
 #include <vector>
 
+#include <cstring>
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -666,6 +669,90 @@ TEST_F(FusionNode, Approx_SetsWithDifferentStampsAreMatched) {
           << name << " stamped with the right image, not the left";
     }
   }
+}
+
+// Issue 25, point 1: a coordinate field of an integer type was read as metres (a UINT8 'x' put
+// 95,129 points in front of the camera): refused, naming the field and its type; and the image set
+// left without a sweep says the sweep was refused (point 4), not that the LiDAR is silent.
+TEST_F(FusionNode, O_IntegerCoordinateFieldIsRefusedNamingItAndTheSetSaysSo) {
+  SetSpec spec;
+  spec.cloud = SetSpec::Cloud::kCustom;
+  spec.custom_cloud = h().makeCloud(SetSpec(), ros::Time(1));
+  spec.custom_cloud->fields[0].datatype = sensor_msgs::PointField::UINT8;  // 'x'
+  const std::size_t mark = h().logMark();
+  const ros::Time stamp = h().nextStamp();
+  h().publishSet(spec, stamp);
+  EXPECT_EQ(h().outputsAfter(stamp), 0);
+  EXPECT_TRUE(h().waitForLog(mark, {"velodyne_points", "'x'", "UINT8"})) << h().logsSince(mark);
+  EXPECT_TRUE(h().waitForLog(mark, {"no usable sweep", "refused", "'x'"})) << h().logsSince(mark);
+  EXPECT_FALSE(h().waitForLog(mark, {"is the LiDAR publishing"}, 0.1)) << h().logsSince(mark);
+  expectStillProducing("a UINT8 x field");
+}
+
+// Issue 25, point 2: left bgr8 with right mono8 is matched as grey on both sides, said once, and
+// gives exactly the disparity of the same pair given as mono8 on both sides.
+TEST_F(FusionNode, P_MixedEncodingsAreMatchedAsGreyAndSaidOnce) {
+  SetSpec mono;
+  mono.left_encoding = mono.right_encoding = "mono8";
+  ros::Time stamp = h().nextStamp();
+  h().publishSet(mono, stamp);
+  ASSERT_TRUE(h().waitForOutputs(stamp));
+  const auto grey = h().image("disparity_image");
+  ASSERT_TRUE(grey);
+  ASSERT_EQ(grey->header.stamp, stamp);
+  const std::vector<uint8_t> grey_pixels = grey->data;
+  SetSpec mixed;
+  mixed.right_encoding = "mono8";
+  const std::size_t mark = h().logMark();
+  for (int i = 0; i < 2; ++i) {
+    stamp = h().nextStamp();
+    h().publishSet(mixed, stamp);
+    ASSERT_TRUE(h().waitForOutputs(stamp)) << "mixed set " << i;
+  }
+  const auto mixed_out = h().image("disparity_image");
+  ASSERT_TRUE(mixed_out);
+  EXPECT_TRUE(mixed_out->data == grey_pixels) << "the mixed pair differs from the grey pair";
+  EXPECT_TRUE(h().waitForLog(mark, {"bgr8", "mono8", "grey"})) << h().logsSince(mark);
+  const std::string said = h().logsSince(mark);
+  EXPECT_EQ(said.find("mono8"), said.rfind("mono8")) << "said more than once:" << said;
+}
+
+// Issue 25, point 3: a left camera_info without a calibration is reported under the left topic.
+TEST_F(FusionNode, Q_LeftCameraInfoProblemsAreReportedUnderTheLeftTopic) {
+  SetSpec spec;
+  spec.left_info_zero = true;
+  const std::size_t mark = h().logMark();
+  const ros::Time stamp = h().nextStamp();
+  h().publishSet(spec, stamp);
+  EXPECT_EQ(h().outputsAfter(stamp), 0);
+  EXPECT_TRUE(h().waitForLog(mark, {"left/camera_info: left camera_info"})) << h().logsSince(mark);
+  EXPECT_FALSE(h().waitForLog(mark, {"right/camera_info: left camera_info"}, 0.1))
+      << h().logsSince(mark);
+  expectStillProducing("an uncalibrated left camera_info");
+}
+
+// Issue 25, point 7: points dropped as NaN / inf or beyond 10 km are counted in the stats.
+TEST_F(FusionNode, R_InvalidPointsOfAValidSweepAreCounted) {
+  const auto base = h().makeCloud(SetSpec(), ros::Time(1));
+  SetSpec spec;
+  spec.cloud = SetSpec::Cloud::kCustom;
+  spec.custom_cloud = boost::make_shared<sensor_msgs::PointCloud2>(*base);
+  const auto put = [&](std::size_t point, std::size_t field, float value) {
+    std::memcpy(&spec.custom_cloud->data[point * spec.custom_cloud->point_step +
+                                         spec.custom_cloud->fields[field].offset],
+                &value, sizeof(float));
+  };
+  put(0, 0, 1e38f);                                          // x = 1e38
+  put(1, 2, std::numeric_limits<float>::infinity());         // z = inf
+  put(2, 1, std::numeric_limits<float>::quiet_NaN());        // y = NaN
+  const ros::Time stamp = h().nextStamp();
+  h().publishSet(spec, stamp);
+  ASSERT_TRUE(h().waitForOutputs(stamp));
+  ASSERT_TRUE(h().stats());
+  EXPECT_EQ(h().stats()->header.stamp, stamp);
+  EXPECT_EQ(h().stats()->points_invalid, 3);
+  EXPECT_EQ(h().stats()->points_in_cloud,
+            static_cast<int>(base->width * base->height) - 3);
 }
 
 int main(int argc, char** argv) {

@@ -1,6 +1,7 @@
 // Regression tests of issue 9's crashes in the ROS conversions (no ROS master needed): each of
 // these messages once took down the nodelet manager. Now each is rejected with a reason.
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -64,6 +65,63 @@ TEST(InputAttacks, FieldOffsetNearTwoToThe32IsRejected) {
   msg.fields[0].offset = 4294967292u;
   EXPECT_FALSE(conv::checkCloudLayout(msg).empty());
   EXPECT_THROW(conv::cloudFromMsg(msg), conv::ConversionError);
+}
+
+// Issue 25, point 1: a coordinate of an integer type was read as metres (a UINT8 'x' put 95,129
+// KITTI points in front of the camera instead of 55,058); a field holding several values was
+// read as its first. Each is refused, naming the field, its type or its count.
+TEST(InputAttacks, CoordinatesOfIntegerTypesAndFieldsWithSeveralValuesAreRefused) {
+  for (const uint8_t type : {PointField::INT8, PointField::UINT8, PointField::INT16,
+                             PointField::UINT16, PointField::INT32, PointField::UINT32}) {
+    for (int axis = 0; axis < 3; ++axis) {
+      auto msg = cloudWithField("intensity", 12);
+      msg.fields[axis].datatype = type;
+      const std::string problem = conv::checkCloudLayout(msg);
+      const std::string name = std::string("'") + "xyz"[axis] + "'";
+      EXPECT_NE(problem.find(name), std::string::npos) << problem;
+      EXPECT_NE(problem.find("FLOAT32 or FLOAT64"), std::string::npos) << problem;
+      EXPECT_THROW(conv::cloudFromMsg(msg), conv::ConversionError);
+    }
+  }
+  auto uint8_x = cloudWithField("intensity", 12);
+  uint8_x.fields[0].datatype = PointField::UINT8;
+  EXPECT_NE(conv::checkCloudLayout(uint8_x).find("UINT8"), std::string::npos);
+  for (const std::string name : {"x", "intensity", "ring", "time"}) {
+    auto msg = cloudWithField(name == "x" ? "intensity" : name, 12);
+    for (auto& f : msg.fields) {
+      if (f.name == name) f.count = 3;
+    }
+    const std::string problem = conv::checkCloudLayout(msg);
+    EXPECT_NE(problem.find("'" + name + "' has count 3"), std::string::npos) << problem;
+  }
+  // A field the reader does not read may hold anything.
+  auto other = cloudWithField("normal", 12);
+  other.fields[3].count = 3;
+  other.fields[3].datatype = PointField::UINT8;
+  EXPECT_EQ(conv::checkCloudLayout(other), "");
+  // Integer rings and intensities are exact and stay accepted.
+  auto ring = cloudWithField("ring", 12);
+  ring.fields[3].datatype = PointField::UINT16;
+  EXPECT_EQ(conv::checkCloudLayout(ring), "");
+}
+
+// Issue 25, point 7: finite but absurd coordinates (1e38) and NaN / inf are dropped and counted.
+TEST(InputAttacks, AbsurdAndNonFinitePointsAreDroppedAndCounted) {
+  auto msg = cloudWithField("intensity", 12);
+  msg.width = 4;
+  msg.row_step = 64;
+  msg.data.assign(64, 0);
+  const auto put = [&](int point, int field, float v) {
+    std::memcpy(&msg.data[point * 16 + field * 4], &v, 4);
+  };
+  put(0, 0, 1e38f);
+  put(1, 2, std::numeric_limits<float>::infinity());
+  put(2, 1, std::numeric_limits<float>::quiet_NaN());
+  put(3, 0, 5.f);
+  const conv::CloudConversion out = conv::cloudFromMsg(msg);
+  EXPECT_EQ(out.cloud.size(), 1u);
+  EXPECT_EQ(out.implausible, 1);
+  EXPECT_EQ(out.non_finite, 2);
 }
 
 // Found by fuzz_pointcloud2: a cloud with width 0 and height > 0 stepped a null data pointer.
@@ -167,6 +225,12 @@ TEST(InputAttacks, WritesTheFuzzSeedCorpora) {
   organised.width = 10;
   organised.row_step = organised.point_step * 10;
   write("pointcloud2", "organised", lsf_fuzz::encodeCloud(organised));
+  sensor_msgs::PointCloud2 uint8_x = velodyne;  // issue 25, point 1
+  uint8_x.fields[0].datatype = PointField::UINT8;
+  write("pointcloud2", "uint8_x", lsf_fuzz::encodeCloud(uint8_x));
+  sensor_msgs::PointCloud2 count3 = velodyne;
+  count3.fields[3].count = 3;
+  write("pointcloud2", "intensity_count_3", lsf_fuzz::encodeCloud(count3));
 
   for (const std::string encoding : {"bgra8", "bgr8", "mono8", "rgb8"}) {
     sensor_msgs::Image image;

@@ -5,6 +5,8 @@
 //   * looped: after two loops (simulated time jumping back) every FusionStats has a positive
 //     latency, frames are still processed, /diagnostics still arrive from the fusion, and
 //     `rostopic echo -n 1 /diagnostics` works (the Python message package is installed).
+// Issue 25, points 5 and 6: no warning blames a missing driver when the bag ends (time stopped),
+// and none advises approximate_sync or max_time_offset when a loop restarts time.
 // The test starts roslaunch itself (the bag must exist first) and ends its process group.
 // Missing data fails under CI=true and skips otherwise.
 #include <signal.h>
@@ -12,6 +14,8 @@
 #include <atomic>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -20,6 +24,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
+#include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/PointCloud2.h>
 
 #include "child_process.h"
@@ -61,6 +66,33 @@ std::unique_ptr<lt::Child> startPlayback(const std::vector<std::string>& args,
   return std::make_unique<lt::Child>(argv, display, log);
 }
 
+/// The fusion's warnings on /rosout while it lives.
+class FusionWarnings {
+ public:
+  explicit FusionWarnings(ros::NodeHandle& nh)
+      : sub_(nh.subscribe<rosgraph_msgs::Log>(
+            "/rosout", 500, [this](const rosgraph_msgs::LogConstPtr& m) {
+              if (m->level < rosgraph_msgs::Log::WARN) return;
+              if (m->name.find("fusion") == std::string::npos) return;
+              std::lock_guard<std::mutex> lock(mutex_);
+              lines_.push_back(m->msg);
+            })) {}
+  /// The warnings containing `part`, one per line.
+  std::string containing(const std::string& part) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::string out;
+    for (const auto& l : lines_) {
+      if (l.find(part) != std::string::npos) out += l + "\n";
+    }
+    return out;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> lines_;
+  ros::Subscriber sub_;
+};
+
 void stopPlayback(std::unique_ptr<lt::Child>& launch) {
   launch->stop(SIGINT, 20.0);
   // The next launch reuses the node names: wait until these are gone.
@@ -87,6 +119,7 @@ TEST(Playback, AtTheEndOfTheBagTheFusionAndRvizStay) {
   ASSERT_TRUE(lt::waitFor(15.0, [&] { return access(socket.c_str(), F_OK) == 0; }));
 
   ros::NodeHandle nh;
+  FusionWarnings warnings(nh);
   std::atomic<int> clouds{0};
   auto sub = nh.subscribe<sensor_msgs::PointCloud2>(
       "/fusion/points2", 2, [&](const sensor_msgs::PointCloud2ConstPtr&) { ++clouds; });
@@ -109,7 +142,22 @@ TEST(Playback, AtTheEndOfTheBagTheFusionAndRvizStay) {
   EXPECT_TRUE(lt::nodeRegistered("/rviz")) << "RViz closed at the end of the bag";
   EXPECT_TRUE(lt::hasSubscriber("/fusion/points2", "/rviz"));
   EXPECT_GT(clouds.load(), 0) << "no fused cloud while the bag played";
+  // ROS time stopped with the bag (more than input_timeout of wall time ago): not a driver gone.
+  EXPECT_EQ(warnings.containing("nothing received"), "");
+  EXPECT_EQ(warnings.containing("no publisher"), "");
   stopPlayback(launch);
+  // Issue 25, point 8: at start-up the fusion says it waits for a subscriber and which inputs it
+  // will then need (the launch's screen output).
+  std::ifstream in(out_dir + "/playback_test_end.log");
+  const std::string printed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(printed.find("waiting for a subscriber on the outputs (e.g. /fusion/depth/image_rect)"),
+            std::string::npos)
+      << printed.substr(0, 4000);
+  EXPECT_NE(printed.find("then subscribing to the inputs /stereo/left/image_rect_color, "
+                         "/stereo/left/camera_info, /stereo/right/image_rect_color, "
+                         "/stereo/right/camera_info, /velodyne_points"),
+            std::string::npos)
+      << printed.substr(0, 4000);
   xvfb.stop();
 }
 
@@ -118,6 +166,7 @@ TEST(Playback, LoopedBagKeepsLatencyPositiveAndDiagnosticsFlowing) {
   const std::string bag = bagPath();
   ASSERT_FALSE(bag.empty());
   ros::NodeHandle nh;
+  FusionWarnings warnings(nh);
   std::mutex mutex;
   int loops = 0;
   double last_clock = 0;
@@ -171,6 +220,10 @@ TEST(Playback, LoopedBagKeepsLatencyPositiveAndDiagnosticsFlowing) {
   EXPECT_EQ(status, 0) << output;
   EXPECT_NE(output.find("status:"), std::string::npos) << output;
 
+  // Sets lost as time restarted are the loop's doing: no advice for a misconfigured rig.
+  EXPECT_EQ(warnings.containing("approximate_sync"), "");
+  EXPECT_EQ(warnings.containing("max_time_offset"), "");
+  EXPECT_EQ(warnings.containing("no publisher"), "");
   std::lock_guard<std::mutex> lock(mutex);
   ASSERT_FALSE(latencies.empty());
   for (size_t i = 0; i < latencies.size(); ++i) {

@@ -26,6 +26,7 @@ struct SparseDisparity {
   cv::Mat1s ring;           ///< ring index of the kept point, -1 where empty or unknown
   int points_in_front = 0;  ///< points with min_depth <= z <= max_depth
   int points_in_image = 0;  ///< of those, points that landed inside the image
+  int points_not_finite = 0;  ///< points skipped because x, y or z is NaN / inf
 };
 
 /// Projects `cloud` with the rigid transform `T_cam_lidar` (LiDAR frame -> left optical frame)

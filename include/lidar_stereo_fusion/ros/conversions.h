@@ -33,6 +33,14 @@ class ConversionError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A camera_info the conversion cannot use; `left` says whose (false: the right one's, or the
+/// pair's), so that the message goes under that topic.
+class CameraInfoError : public ConversionError {
+ public:
+  CameraInfoError(bool left, const std::string& what) : ConversionError(what), left(left) {}
+  bool left;
+};
+
 /// Image encodings accepted for the stereo pair: bgra8 (ZED), rgba8, bgr8, rgb8, mono8.
 const std::vector<std::string>& supportedImageEncodings();
 
@@ -45,16 +53,19 @@ std::string checkImage(const sensor_msgs::Image& msg);
 /// encoding or a malformed message.
 cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg);
 
-/// Converts a stereo pair; the two results have the same type (mono + colour: both BGR).
-/// Throws ConversionError when either image is unusable or the sizes differ.
+/// Converts a stereo pair; the two results have the same type. A mono8 view with a colour view:
+/// both are matched as grey (the colour one converted with OpenCV's BGR2GRAY), since a grey view
+/// cannot be matched against colours; `note` (if given) then says so, naming both encodings, and
+/// is empty otherwise. Throws ConversionError when either image is unusable or the sizes differ.
 void stereoPairToCore(const sensor_msgs::ImageConstPtr& left,
                       const sensor_msgs::ImageConstPtr& right, cv::Mat& left_out,
-                      cv::Mat& right_out);
+                      cv::Mat& right_out, std::string* note = nullptr);
 
 /// Rectified stereo camera from the two camera_infos: fx, fy, cx, cy from the left projection
 /// matrix P; baseline B [m] = |Tx_right - Tx_left| / fx with Tx = P[3] (so both sign conventions,
 /// Tx = -fx * B as in ROS and +fx * B as some drivers write it, work). Throws ConversionError
-/// (naming "left"/"right" and the field) when P is zero, the focal lengths disagree or B is 0.
+/// CameraInfoError (naming "left"/"right" and the field) when P is zero, the focal lengths
+/// disagree or B is 0.
 StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
                                   const sensor_msgs::CameraInfo& right);
 
@@ -65,10 +76,15 @@ struct CloudConversion {
   bool has_time = false;  ///< the message had a `time` field [s within the sweep]
   int total_points = 0;   ///< width * height of the message
   int non_finite = 0;     ///< points skipped because x, y or z was NaN / inf
+  int implausible = 0;    ///< points skipped because |x|, |y| or |z| > kMaxCoordinate
 };
 
-/// Checks the layout of a cloud without reading its points: x, y, z fields present with a numeric
-/// type, point_step / row_step / data size consistent, little-endian. Returns an empty string when
+/// [m] A coordinate beyond this is no LiDAR return (e.g. 1e38 in a corrupt sweep): dropped, counted.
+constexpr double kMaxCoordinate = 1e4;
+
+/// Checks the layout of a cloud without reading its points: x, y, z fields present as FLOAT32 or
+/// FLOAT64, the fields read (x, y, z, intensity, ring, time) with count 1 and a numeric type,
+/// point_step / row_step / data size consistent, little-endian. Returns an empty string when
 /// usable, else the problem.
 std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg);
 

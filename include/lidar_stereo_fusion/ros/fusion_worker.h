@@ -55,6 +55,7 @@ class FusionWorker {
   Counters counters_;
   InputGate gate_;
   OutputPublisher outputs_;
+  std::string mixed_encodings_said_;  ///< the last mixed-encoding note logged (worker thread)
 
   // TF (own listener thread).
   tf2_ros::Buffer tf_buffer_;

@@ -93,6 +93,8 @@ class InputGate {
   /// Incremented whenever ROS time or the stamps restart (a bag loop): a set that arrived in an
   /// earlier epoch cannot measure its latency in ROS time.
   uint32_t clockEpoch() const { return clock_epoch_; }
+  /// The input topics (resolved), comma-separated.
+  std::string inputTopics() const;
 
  private:
   using Image = sensor_msgs::Image;
@@ -110,6 +112,14 @@ class InputGate {
   // With mutex_ held:
   void handleEvents(InputMatcher::Events& events, const std::string& topic, const ros::Time& stamp);
   void detectClockJump();
+  /// Now on the watch's clock: wall time, or ROS time under /use_sim_time (as a time point).
+  static InputWatch::Clock::time_point watchNow();
+  void restarted(const ros::Time& now);
+  bool inRestartGrace() const { return ros::Time::now() < restart_grace_until_; }
+  /// Whether a sweep refused lately (reject) could have been the one for the set at `image_stamp`.
+  bool sweepRefusedNear(const ros::Time& image_stamp) const;
+  /// Why no sweep matched the image set at `image_stamp` (unmatched, or `waited` for a later one).
+  std::string noSweepText(const ros::Time& image_stamp, bool waited) const;
   void waitForFresher(std::unique_lock<std::mutex>& lock);
   std::string topicName(const std::string& relative) const { return nh_.resolveName(relative); }
 
@@ -127,6 +137,7 @@ class InputGate {
   std::atomic<bool> subscribed_{false};
   InputWatch watch_;  ///< names silent inputs (its own lock)
   ros::WallTimer watch_timer_;
+  std::atomic<bool> watch_clock_started_{false};  ///< under sim time: the watch saw a clock
 
   std::mutex mutex_;  ///< the one lock
   std::condition_variable ready_cv_;
@@ -136,6 +147,12 @@ class InputGate {
   RateLimiter rate_;
   FreshWait fresh_;
   ros::Time last_clock_;
+  /// Until this ROS time, sets lost to a restart of time (a bag loop) are not warned about with
+  /// advice meant for a misconfigured rig.
+  ros::Time restart_grace_until_;
+  /// The last sweep refused (reject), so that a set left without one says why.
+  ros::Time refused_sweep_stamp_;
+  std::string refused_sweep_problem_;
   bool stop_ = false;
   std::atomic<bool> stopped_{false};
   std::atomic<uint32_t> clock_epoch_{0};

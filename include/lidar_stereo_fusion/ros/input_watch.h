@@ -1,6 +1,7 @@
 // Names the input topics that publish nothing: a rig whose driver is missing, not running or not
 // remapped otherwise waits in silence. While the inputs are subscribed, a topic that has sent
-// nothing for `timeout` seconds of wall time is warned about, naming the topic and how many
+// nothing for `timeout` seconds is warned about (the caller's clock: wall time on a rig, ROS time
+// under /use_sim_time, where a slowed or ended bag is not silence), naming the topic and how many
 // publishers it has: repeatedly (throttled) while it has never sent anything, once when it went
 // quiet after sending (e.g. the end of a bag), again only after it sent something.
 #pragma once

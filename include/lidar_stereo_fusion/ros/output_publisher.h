@@ -40,6 +40,7 @@ struct FrameReport {
   std::string method;
   double conversion_ms = 0;  ///< ROS conversion in (the output conversion is added here)
   int cloud_points = 0;      ///< finite points of the sweep
+  int invalid_points = 0;    ///< points dropped: NaN / inf, or beyond kMaxCoordinate
   RingRecovery rings;
 };
 
