@@ -106,6 +106,7 @@ void OutputPublisher::advertise() {
   pub_depth_color_ = it_->advertise("depth/image_color", 1, it_cb, it_cb);
   pub_lidar_disparity_ = it_->advertise("lidar_disparity", 1, it_cb, it_cb);
   pub_disparity_image_ = it_->advertise("disparity_image", 1, it_cb, it_cb);
+  pub_disparity_color_ = it_->advertise("disparity_image_color", 1, it_cb, it_cb);
   pub_confidence_ = it_->advertise("confidence", 1, it_cb, it_cb);
 }
 
@@ -123,7 +124,8 @@ void OutputPublisher::connectCb() {
       pub_disparity_.getNumSubscribers() + pub_points_.getNumSubscribers() +
       pub_stats_.getNumSubscribers() + pub_depth_.getNumSubscribers() +
       pub_depth_color_.getNumSubscribers() + pub_lidar_disparity_.getNumSubscribers() +
-      pub_disparity_image_.getNumSubscribers() + pub_confidence_.getNumSubscribers();
+      pub_disparity_image_.getNumSubscribers() + pub_disparity_color_.getNumSubscribers() +
+      pub_confidence_.getNumSubscribers();
   if (subscribers == 0 && gate_.subscribed()) {
     gate_.unsubscribe();
   } else if (subscribers > 0 && !gate_.subscribed()) {
@@ -141,7 +143,8 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
     depth = disparityToDepth(result.disparity, camera);
 
   stereo_msgs::DisparityImagePtr disparity_msg;
-  sensor_msgs::ImagePtr depth_msg, depth_color_msg, prior_msg, disparity_image_msg, confidence_msg;
+  sensor_msgs::ImagePtr depth_msg, depth_color_msg, prior_msg, disparity_image_msg,
+      disparity_color_msg, confidence_msg;
   sensor_msgs::CameraInfoPtr depth_info;
   sensor_msgs::PointCloud2Ptr points_msg;
   if (pub_disparity_.getNumSubscribers() > 0) {
@@ -151,6 +154,12 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
   }
   if (pub_disparity_image_.getNumSubscribers() > 0) {
     disparity_image_msg = conversions::floatImageToMsg(result.disparity, header);
+  }
+  if (pub_disparity_color_.getNumSubscribers() > 0) {
+    // As depth/image_color: colours over the search range with a scale bar in px.
+    const double max = params.patchmatch.max_disparity;
+    disparity_color_msg = conversions::bgrImageToMsg(
+        withColorBar(colorizeDisparity(result.disparity, max), 0.0, max, "px"), header);
   }
   // One depth range for depth/image_rect and points2: the pipeline's (projection max_depth),
   // clipped further by ~max_output_depth.
@@ -193,6 +202,7 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
   if (depth_msg) pub_depth_.publish(depth_msg, depth_info);
   if (depth_color_msg) pub_depth_color_.publish(depth_color_msg);
   if (disparity_image_msg) pub_disparity_image_.publish(disparity_image_msg);
+  if (disparity_color_msg) pub_disparity_color_.publish(disparity_color_msg);
   if (prior_msg) pub_lidar_disparity_.publish(prior_msg);
   if (confidence_msg) pub_confidence_.publish(confidence_msg);
   if (points_msg) pub_points_.publish(points_msg);

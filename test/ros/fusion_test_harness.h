@@ -35,7 +35,7 @@ constexpr double kNoOutputWait = 1.5;    ///< [s] > max_sweep_wait + processing 
 const std::vector<std::string> kOutputs = {
     "disparity",         "depth/image_rect", "depth/camera_info",
     "depth/image_color", "points2",          "lidar_disparity",
-    "disparity_image",   "confidence",       "stats"};
+    "disparity_image",   "disparity_image_color", "confidence", "stats"};
 
 /// How one input set is made.
 struct SetSpec {

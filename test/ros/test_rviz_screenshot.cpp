@@ -31,6 +31,7 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "child_process.h"
 #include "synthetic_input.h"
@@ -152,6 +153,23 @@ double changedFraction(const cv::Mat3b& a, const cv::Mat3b& b, const cv::Rect& b
   return box.area() > 0 ? static_cast<double>(changed) / box.area() : 0.0;
 }
 
+/// Fraction of the pixels in `box` of a strong colour (HSV saturation > 150 and value > 80 of
+/// 255): the colour maps of depth and disparity, not grey panels or the background.
+double colourfulFraction(const cv::Mat3b& image, const cv::Rect& box) {
+  const cv::Rect inside = box & cv::Rect(0, 0, image.cols, image.rows);
+  if (inside.area() == 0) return 0.0;
+  cv::Mat hsv;
+  cv::cvtColor(image(inside), hsv, cv::COLOR_BGR2HSV);
+  int strong = 0;
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      const cv::Vec3b& p = hsv.at<cv::Vec3b>(y, x);
+      strong += p[1] > 150 && p[2] > 80;
+    }
+  }
+  return static_cast<double>(strong) / inside.area();
+}
+
 }  // namespace
 
 TEST(RvizScreenshot, FusedCloudIsDrawn) {
@@ -222,6 +240,27 @@ TEST(RvizScreenshot, FusedCloudIsDrawn) {
   EXPECT_LT(still, 0.01) << "the view changes by itself; the comparison would mean nothing";
   EXPECT_GT(fused_change, 0.05) << "the fused cloud is not drawn (compare " << shot_a << " and "
                                 << shot_b << ")";
+  // Issue 25, point 9: the panels where rviz/fusion.rviz puts them, readable. Right of the 3D
+  // view, top to bottom: the left image, the depth and the disparity, the last two in colour
+  // (TURBO, a scale bar below); the left dock below the display list holds no picture (the depth
+  // panel was dropped there, small, when its saved name did not match the display's).
+  const cv::Rect right_dock(view.br().x + 20, view.y, b.cols - view.br().x - 20, view.height);
+  const cv::Rect left_below(0, view.y + 3 * view.height / 4, std::max(1, view.x - 20),
+                            view.height / 4);
+  const int third = right_dock.height / 3;
+  const cv::Rect depth_panel(right_dock.x, right_dock.y + third, right_dock.width, third);
+  const cv::Rect disparity_panel(right_dock.x, right_dock.y + 2 * third, right_dock.width, third);
+  const double depth_colour = colourfulFraction(b, depth_panel);
+  const double disparity_colour = colourfulFraction(b, disparity_panel);
+  const double left_dock_colour = colourfulFraction(b, left_below);
+  std::cout << "colourful: depth panel " << 100 * depth_colour << " %, disparity panel "
+            << 100 * disparity_colour << " %, left dock below the displays "
+            << 100 * left_dock_colour << " %\n";
+  EXPECT_GT(depth_colour, 0.10) << "no coloured depth in the middle of the right dock (" << shot_b
+                                << ")";
+  EXPECT_GT(disparity_colour, 0.10) << "no coloured disparity at the bottom of the right dock ("
+                                    << shot_b << ")";
+  EXPECT_LT(left_dock_colour, 0.01) << "a picture in the left dock (" << shot_b << ")";
   rviz.stop();
   xvfb.stop();
 }

@@ -87,7 +87,8 @@ class OutputPublisher {
   ros::Publisher pub_disparity_, pub_points_, pub_stats_;
   image_transport::CameraPublisher pub_depth_;  ///< depth/image_rect + depth/camera_info
   image_transport::Publisher pub_depth_color_;  ///< depth/image_color
-  image_transport::Publisher pub_lidar_disparity_, pub_disparity_image_, pub_confidence_;
+  image_transport::Publisher pub_lidar_disparity_, pub_disparity_image_, pub_disparity_color_,
+      pub_confidence_;
 
   diagnostic_updater::Updater updater_;
   diagnostic_updater::FrequencyStatus output_frequency_;
