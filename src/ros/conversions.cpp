@@ -269,6 +269,32 @@ bool hostIsBigEndian() {
 
 }  // namespace
 
+std::string checkCloudFieldTypes(const sensor_msgs::PointCloud2& msg) {
+  std::ostringstream problem;
+  for (const auto& f : msg.fields) {
+    const bool coordinate = f.name == "x" || f.name == "y" || f.name == "z";
+    const bool read = coordinate || f.name == "intensity" || f.name == "ring" || f.name == "time";
+    if (!read) continue;
+    if (datatypeSize(f.datatype) == 0) {
+      problem << "field '" << f.name << "' has unknown datatype " << static_cast<int>(f.datatype);
+      return problem.str();
+    }
+    // A coordinate stored as an integer is not metres (a UINT8 'x' put 95,129 points in front of
+    // the camera instead of 55,058): refused, as is a field holding other than one value.
+    if (coordinate && f.datatype != PointField::FLOAT32 && f.datatype != PointField::FLOAT64) {
+      problem << "field '" << f.name << "' is " << datatypeName(f.datatype) << " (datatype "
+              << static_cast<int>(f.datatype) << "): coordinates must be FLOAT32 or FLOAT64 [m]";
+      return problem.str();
+    }
+    if (f.count != 1) {
+      problem << "field '" << f.name << "' has count " << f.count << " ("
+              << datatypeName(f.datatype) << "): one value per point is read";
+      return problem.str();
+    }
+  }
+  return {};
+}
+
 std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg) {
   std::ostringstream problem;
   if (msg.is_bigendian != hostIsBigEndian()) {
@@ -284,29 +310,11 @@ std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg) {
       return problem.str();
     }
   }
+  const std::string types = checkCloudFieldTypes(msg);
+  if (!types.empty()) return types;
   for (const auto& f : msg.fields) {
     const int size = datatypeSize(f.datatype);
-    const bool coordinate = f.name == "x" || f.name == "y" || f.name == "z";
-    const bool read = coordinate || f.name == "intensity" || f.name == "ring" || f.name == "time";
-    if (size == 0) {
-      if (read) {
-        problem << "field '" << f.name << "' has unknown datatype " << static_cast<int>(f.datatype);
-        return problem.str();
-      }
-      continue;
-    }
-    // A coordinate stored as an integer is not metres (a UINT8 'x' put 95,129 points in front of
-    // the camera instead of 55,058): refused, as is a field holding other than one value.
-    if (coordinate && f.datatype != PointField::FLOAT32 && f.datatype != PointField::FLOAT64) {
-      problem << "field '" << f.name << "' is " << datatypeName(f.datatype) << " (datatype "
-              << static_cast<int>(f.datatype) << "): coordinates must be FLOAT32 or FLOAT64 [m]";
-      return problem.str();
-    }
-    if (read && f.count != 1) {
-      problem << "field '" << f.name << "' has count " << f.count << " ("
-              << datatypeName(f.datatype) << "): one value per point is read";
-      return problem.str();
-    }
+    if (size == 0) continue;  // a field this reader does not read (checkCloudFieldTypes)
     // 64-bit sum: an offset near 2^32 must not wrap round and pass.
     if (static_cast<uint64_t>(f.offset) + static_cast<uint64_t>(size) > msg.point_step) {
       problem << "field '" << f.name << "' (offset " << f.offset << ", " << size

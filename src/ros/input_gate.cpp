@@ -51,6 +51,10 @@ boost::optional<Rejection> checkImageSet(const ImageSet& set) {
 }
 
 boost::optional<Rejection> checkCloud(const sensor_msgs::PointCloud2& cloud) {
+  // Field types first, as their own kind of problem: a cloud of the wrong types is not a damaged
+  // one, and its warning must not be throttled away by another layout problem's.
+  const std::string types = conversions::checkCloudFieldTypes(cloud);
+  if (!types.empty()) return Rejection{kCloud, "field type", types};
   const std::string problem = conversions::checkCloudLayout(cloud);
   if (!problem.empty()) return Rejection{kCloud, "layout", problem};
   if (cloud.width == 0 || cloud.height == 0) {
@@ -224,6 +228,7 @@ void InputGate::reject(const Rejection& r, const ros::Time& stamp, const char* w
     std::lock_guard<std::mutex> lock(mutex_);
     refused_sweep_stamp_ = stamp;
     refused_sweep_problem_ = r.problem;
+    refused_sweep_kind_ = r.kind;
   }
   ++counters_.invalid;
   log_.warn(r.topic, r.kind,
@@ -399,9 +404,10 @@ void InputGate::handleEvents(InputMatcher::Events& events, const std::string& to
                    " skipped: time restarted (bag loop) before its sweep came");
       continue;
     }
-    const char* kind = sweepRefusedNear(events.unmatched[i]) ? "refused"
-                       : events.unmatched_waited[i]             ? "late"
-                                                                : "unmatched";
+    const bool refused = sweepRefusedNear(events.unmatched[i]);
+    const std::string kind = refused                      ? "refused " + refused_sweep_kind_
+                             : events.unmatched_waited[i] ? "late"
+                                                          : "unmatched";
     log_.warn(kCloud, kind, noSweepText(events.unmatched[i], events.unmatched_waited[i]));
   }
   if (events.ready.empty()) return;

@@ -1,7 +1,9 @@
 #include "lidar_stereo_fusion/ros/output_publisher.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
+#include <vector>
 
 #include <boost/make_shared.hpp>
 
@@ -156,8 +158,21 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
     disparity_image_msg = conversions::floatImageToMsg(result.disparity, header);
   }
   if (pub_disparity_color_.getNumSubscribers() > 0) {
-    // As depth/image_color: colours over the search range with a scale bar in px.
-    const double max = params.patchmatch.max_disparity;
+    // As depth/image_color, with a scale bar in px: up to the frame's 99th percentile of
+    // disparity rounded up to 16 px (the search range, 192 px, or a few near outliers would leave
+    // a street's 5-60 px in one colour); larger ones take the top colour.
+    std::vector<float> values;
+    values.reserve(result.disparity.total());
+    for (const float d : result.disparity) {
+      if (d > 0.f) values.push_back(d);
+    }
+    double top = 16.0;
+    if (!values.empty()) {
+      auto at = values.begin() + static_cast<std::ptrdiff_t>(0.99 * (values.size() - 1));
+      std::nth_element(values.begin(), at, values.end());
+      top = 16.0 * std::max(1.0, std::ceil(*at / 16.0));
+    }
+    const double max = std::min(params.patchmatch.max_disparity, top);
     disparity_color_msg = conversions::bgrImageToMsg(
         withColorBar(colorizeDisparity(result.disparity, max), 0.0, max, "px"), header);
   }

@@ -88,6 +88,10 @@ constexpr double kMaxCoordinate = 1e4;
 /// usable, else the problem.
 std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg);
 
+/// The part of checkCloudLayout about the fields' types: x, y, z FLOAT32 or FLOAT64, the fields
+/// read with count 1 and a known numeric type. Empty when usable, else the problem.
+std::string checkCloudFieldTypes(const sensor_msgs::PointCloud2& msg);
+
 /// Reads a sweep as velodyne_pointcloud publishes it (x, y, z, intensity, ring, time) or any other
 /// layout with at least x, y, z. `intensity`, `ring` and `time` are optional and may have any
 /// numeric datatype (float32/64, (u)int8/16/32). Non-finite points are skipped and counted.

@@ -152,7 +152,7 @@ class InputGate {
   ros::Time restart_grace_until_;
   /// The last sweep refused (reject), so that a set left without one says why.
   ros::Time refused_sweep_stamp_;
-  std::string refused_sweep_problem_;
+  std::string refused_sweep_problem_, refused_sweep_kind_;
   bool stop_ = false;
   std::atomic<bool> stopped_{false};
   std::atomic<uint32_t> clock_epoch_{0};
