@@ -12,7 +12,9 @@
 // else the left-right check is the 1/2-size level's, up-sampled. After a coarse start, the pixels
 // without LiDAR bounds that the level below's left-right check marks inconsistent are not searched
 // (skip_inconsistent; at 1/2 size the interior of those regions only): they pass the plane before
-// them on, as the hole filling would (leaveToFill).
+// them on, as the hole filling would (leaveToFill). With search_scale > 1 a level does not search:
+// the level below checks and fills, and this level up-samples its result (upsampledResult); with
+// unbounded_scale > 1 the pixels without bounds keep the level below's plane (kKeptFromGuide).
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>

@@ -62,8 +62,10 @@ void prepareView(const ViewInput& in, const PatchMatchParams& p, float match_sig
 /// the pixels locked to the prior (a level that does not search, PatchMatchParams::search_scale).
 void preparePrior(const ViewInput& in, const PatchMatchParams& p, ViewState& v);
 
-/// Sets the coarse level's planes as `v`'s guide and, unless full_size_unbounded, settles the
-/// pixels without scan-line bounds that are not locked to the prior: they keep the guide's plane.
+/// Sets the coarse level's planes as `v`'s guide and settles the pixels without scan-line bounds
+/// that are not locked to the prior: at a level finer than unbounded_scale they keep the guide's
+/// plane as it is (kKeptFromGuide); else, unless full_size_unbounded, they keep it polished
+/// (kSettledByGuide).
 void setGuide(std::vector<Plane> guide, const PatchMatchParams& p, ViewState& v);
 
 /// Marks the pixels of the left view that are set in `inconsistent` (the level below's
