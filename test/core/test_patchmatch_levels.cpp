@@ -149,8 +149,8 @@ TEST(PatchMatchCoarseStart, AtUnboundedScale2StereoOnlyPixelsAreTheHalfSizePlane
     lsf::PatchMatchStereo half_level(pm::coarseParams(p));
     const lsf::PatchMatchResult half = half_level.compute(pm::downsampleView({s.left}, 2),
                                                           pm::downsampleView({s.right}, 2));
-    // compute() of a stand-alone solver is not an intermediate level: with intermediate_refine
-    // false the levels differ, so only its plane layout is compared then.
+    // A stand-alone solver is not an intermediate level, so it refines its right view whatever
+    // intermediate_refine says: the planes are compared only where that is the same (true).
     const std::vector<pm::Plane> up = pm::upsamplePlanes(half.planes, 2, s.left.size());
     int same = 0;
     for (int y = 0; y < 48; ++y) {
