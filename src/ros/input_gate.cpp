@@ -260,8 +260,20 @@ InputWatch::Clock::time_point InputGate::watchNow() {
 void InputGate::restarted(const ros::Time& now) {
   // The sets in flight when time restarts lose their partners (the synchroniser's queue, the
   // sweep buffer): for a moment, a lost set is the restart's doing, not the rig's.
+  restart_time_ = now;
   restart_grace_until_ =
       now + ros::Duration(1.0 + params_.max_sweep_wait + params_.max_time_offset);
+}
+
+bool InputGate::lostToRestart(const ros::Time& stamp) const {
+  if (restart_time_.isZero()) return false;
+  const ros::Time now = ros::Time::now();
+  // Within a few seconds of a restart (ROS time, as the bag plays on): a set lost while time
+  // restarted, a set of the first moments after it that the synchroniser gives up on only when
+  // its queue overflows, or a set stamped before the jump (ahead of the clock now).
+  if (now > restart_time_ + ros::Duration(10.0) || now < restart_time_) return false;
+  return now < restart_grace_until_ || stamp <= restart_grace_until_ ||
+         stamp > now + ros::Duration(0.5);
 }
 
 std::string InputGate::inputTopics() const {
@@ -331,12 +343,6 @@ void InputGate::syncDropCb(const sensor_msgs::ImageConstPtr& left,
                            const sensor_msgs::CameraInfoConstPtr& right_info) {
   // ExactTime gave up on an incomplete set (a partner message never came with the same stamp).
   ++counters_.unmatched;
-  bool restart;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    detectClockJump();  // the synchroniser may give up on a set before any callback saw the jump
-    restart = inRestartGrace();
-  }
   std::string missing;
   if (!left) missing += std::string(" ") + topicName(kLeftImage);
   if (!left_info) missing += std::string(" ") + topicName(kLeftInfo);
@@ -351,6 +357,12 @@ void InputGate::syncDropCb(const sensor_msgs::ImageConstPtr& left,
     stamp = left_info->header.stamp;
   else if (right_info)
     stamp = right_info->header.stamp;
+  bool restart;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    detectClockJump();  // the synchroniser may give up on a set before any callback saw the jump
+    restart = lostToRestart(stamp);
+  }
   if (restart) {
     log_.log(ThrottledLog::Level::kInfo, "image set", "restart",
              "incomplete image set at stamp " + stampText(stamp) +
@@ -398,7 +410,7 @@ void InputGate::handleEvents(InputMatcher::Events& events, const std::string& to
   }
   for (std::size_t i = 0; i < events.unmatched.size(); ++i) {
     ++counters_.unmatched;
-    if (inRestartGrace()) {
+    if (lostToRestart(events.unmatched[i])) {
       log_.log(ThrottledLog::Level::kInfo, kCloud, "restart",
                "image set at " + stampText(events.unmatched[i]) +
                    " skipped: time restarted (bag loop) before its sweep came");

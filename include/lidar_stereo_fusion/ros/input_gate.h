@@ -115,7 +115,8 @@ class InputGate {
   /// Now on the watch's clock: wall time, or ROS time under /use_sim_time (as a time point).
   static InputWatch::Clock::time_point watchNow();
   void restarted(const ros::Time& now);
-  bool inRestartGrace() const { return ros::Time::now() < restart_grace_until_; }
+  /// Whether the set stamped `stamp` was lost to a restart of time (a bag loop), not to the rig.
+  bool lostToRestart(const ros::Time& stamp) const;
   /// Whether a sweep refused lately (reject) could have been the one for the set at `image_stamp`.
   bool sweepRefusedNear(const ros::Time& image_stamp) const;
   /// Why no sweep matched the image set at `image_stamp` (unmatched, or `waited` for a later one).
@@ -149,7 +150,7 @@ class InputGate {
   ros::Time last_clock_;
   /// Until this ROS time, sets lost to a restart of time (a bag loop) are not warned about with
   /// advice meant for a misconfigured rig.
-  ros::Time restart_grace_until_;
+  ros::Time restart_time_, restart_grace_until_;
   /// The last sweep refused (reject), so that a set left without one says why.
   ros::Time refused_sweep_stamp_;
   std::string refused_sweep_problem_, refused_sweep_kind_;
