@@ -27,17 +27,27 @@ void requireTextFile(const std::string& text, const std::string& path, const std
 
 void requireYamlMarkersAlone(const std::string& text, const std::string& path,
                              const std::string& what) {
+  int document_end = 0;  // the line of the last '...' while no '---' has followed it
   forEachLine(text, [&](int number, std::string_view line) {
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first == std::string_view::npos) return;
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string_view::npos || line[first] == '#') return;
     const std::string_view marker = line.substr(first, 3);
-    if (marker != "---" && marker != "...") return;
+    if (marker != "---" && marker != "...") {
+      if (document_end > 0) {
+        throw std::runtime_error(what + " " + path + " line " + std::to_string(number) +
+                                 ": content after the document end '...' of line " +
+                                 std::to_string(document_end) +
+                                 " (a new YAML document starts with '---')");
+      }
+      return;
+    }
     const std::size_t rest = line.find_first_not_of(" \t\r", first + 3);
     if (rest != std::string_view::npos && line[rest] != '#') {
       throw std::runtime_error(what + " " + path + " line " + std::to_string(number) + ": '" +
                                std::string(marker) +
                                "' (a YAML document marker) must be alone on its line");
     }
+    document_end = marker == "..." ? number : 0;
   });
 }
 

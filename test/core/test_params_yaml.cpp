@@ -339,9 +339,17 @@ TEST(ParamsYaml, ContentOnADocumentMarkerLineIsAnErrorNamingTheLine) {
   }
   const std::string end = loadError("method: pms\n... seed: 3\n");
   EXPECT_NE(end.find("line 2: '...'"), std::string::npos) << end;
+  // After a document end only a new document ('---') may come: a '-' there loops the parser too
+  // ("...\n-", found by fuzzing in CI), even indented or after blank and comment lines.
+  for (const char* text : {"...\n-", "method: pms\n...\n- a\n", "...\n\n# c\n -x\n"}) {
+    const std::string after = loadError(text);
+    EXPECT_NE(after.find("content after the document end '...'"), std::string::npos) << after;
+  }
+  EXPECT_NE(loadError("method: pms\n...\n\n-\n").find("line 4"), std::string::npos);
   // A marker alone, or with blanks or a comment after it, is fine.
   for (const char* text :
-       {"---\nmethod: pms\n", "---   \nmethod: pms\n", "--- # doc\nmethod: pms\n"}) {
+       {"---\nmethod: pms\n", "---   \nmethod: pms\n", "--- # doc\nmethod: pms\n",
+        "method: pms\n...\n", "method: pms\n...\n# end\n"}) {
     YamlFile alone(text);
     FusionParams p;
     EXPECT_NO_THROW(loadParamsYaml(alone.path(), p)) << text;

@@ -35,6 +35,8 @@ void requireTextFile(const std::string& text, const std::string& path, const std
 /// marker's line ends at the next less indented line, and the parser then skips three characters
 /// as if they were a marker; a lone '-' there makes its search for the next document spin
 /// without advancing (found by fuzzing the parameter reader: "---hod: pms\npat-hod: pms\nc: 1").
+/// Also when anything but blanks, comments or a "---" follows a "..." (document end): the parser
+/// loops the same way on a '-' there ("...\n-", found by fuzzing too).
 void requireYamlMarkersAlone(const std::string& text, const std::string& path,
                              const std::string& what);
 
