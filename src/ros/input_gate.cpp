@@ -257,23 +257,20 @@ InputWatch::Clock::time_point InputGate::watchNow() {
   return InputWatch::Clock::time_point(std::chrono::nanoseconds(ros::Time::now().toNSec()));
 }
 
-void InputGate::restarted(const ros::Time& now) {
-  // The sets in flight when time restarts lose their partners (the synchroniser's queue, the
-  // sweep buffer): for a moment, a lost set is the restart's doing, not the rig's.
-  restart_time_ = now;
-  restart_grace_until_ =
-      now + ros::Duration(1.0 + params_.max_sweep_wait + params_.max_time_offset);
-}
+void InputGate::restarted(const ros::Time& now) { restart_time_ = now; }
 
 bool InputGate::lostToRestart(const ros::Time& stamp) const {
   if (restart_time_.isZero()) return false;
   const ros::Time now = ros::Time::now();
-  // Within a few seconds of a restart (ROS time, as the bag plays on): a set lost while time
-  // restarted, a set of the first moments after it that the synchroniser gives up on only when
-  // its queue overflows, or a set stamped before the jump (ahead of the clock now).
+  // The sets in flight when time restarts lose their partners (the synchroniser's queue, the
+  // sweep buffer). Within a few seconds of a restart (ROS time, as the bag plays on), a set is the
+  // restart's loss, not the rig's, if it was lost right after it, if it is of the first moments
+  // after it (the synchroniser gives up on such a set only when its queue overflows), or if it
+  // is stamped before the jump (ahead of the clock now).
   if (now > restart_time_ + ros::Duration(10.0) || now < restart_time_) return false;
-  return now < restart_grace_until_ || stamp <= restart_grace_until_ ||
-         stamp > now + ros::Duration(0.5);
+  const ros::Time grace_end =
+      restart_time_ + ros::Duration(1.0 + params_.max_sweep_wait + params_.max_time_offset);
+  return now < grace_end || stamp <= grace_end || stamp > now + ros::Duration(0.5);
 }
 
 std::string InputGate::inputTopics() const {

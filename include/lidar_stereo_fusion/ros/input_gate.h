@@ -148,9 +148,9 @@ class InputGate {
   RateLimiter rate_;
   FreshWait fresh_;
   ros::Time last_clock_;
-  /// Until this ROS time, sets lost to a restart of time (a bag loop) are not warned about with
-  /// advice meant for a misconfigured rig.
-  ros::Time restart_time_, restart_grace_until_;
+  /// ROS time of the last restart of time (a bag loop): for a moment after it, lost sets are not
+  /// warned about with advice meant for a misconfigured rig (lostToRestart).
+  ros::Time restart_time_;
   /// The last sweep refused (reject), so that a set left without one says why.
   ros::Time refused_sweep_stamp_;
   std::string refused_sweep_problem_, refused_sweep_kind_;
