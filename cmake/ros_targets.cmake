@@ -11,6 +11,8 @@ set(LSF_ROS_INCLUDE_DIRS
 
 add_library(${PROJECT_NAME}_ros
   src/ros/conversions.cpp
+  src/ros/cloud_conversions.cpp
+  src/ros/ego_motion.cpp
   src/ros/ros_params.cpp
   src/ros/node_support.cpp
   src/ros/input_gate.cpp

@@ -20,8 +20,11 @@
 namespace lsf_fuzz {
 
 inline const std::vector<std::string>& fieldNames() {
-  static const std::vector<std::string> kNames = {"x", "y", "z", "intensity", "ring", "time",
-                                                  "rgb", "other"};
+  // The per-point time fields of the common drivers (conversions::PointTimeField) included;
+  // "other" stays last (encodeCloud writes it for any name not listed).
+  static const std::vector<std::string> kNames = {
+      "x",         "y",        "z",         "intensity", "ring", "time", "t", "offset_time",
+      "timestamp", "time_sec", "time_nsec", "rgb",       "other"};
   return kNames;
 }
 inline const std::vector<std::string>& encodings() {

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -14,6 +15,8 @@
 #include <boost/bind/bind.hpp>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
+#include "lidar_stereo_fusion/core/motion_compensation.h"
+#include "lidar_stereo_fusion/ros/ego_motion.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
 #include "lidar_stereo_fusion/ros/ros_params.h"
 
@@ -156,18 +159,21 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   const std::string& camera_frame = set.left->header.frame_id;
   const std::string& lidar_frame = cloud_msg.header.frame_id;
 
-  // Extrinsics at the sweep stamp; a short timeout bounds the wait (worker thread only).
+  // Extrinsics at the sweep stamp, or at the image stamp the points are moved to with
+  // ~fixed_frame; a short timeout bounds the wait (worker thread only).
+  const ros::Time extrinsics_stamp =
+      node_params_.fixed_frame.empty() ? match.sweep_stamp : match.image_stamp;
   FusionInput input;
   try {
     const geometry_msgs::TransformStamped tf = tf_buffer_.lookupTransform(
-        camera_frame, lidar_frame, match.sweep_stamp, ros::Duration(node_params_.tf_timeout));
+        camera_frame, lidar_frame, extrinsics_stamp, ros::Duration(node_params_.tf_timeout));
     input.T_cam_lidar = tf2::transformToEigen(tf);
   } catch (const tf2::TransformException& e) {
     ++counters_.tf_failures;
     log_.warn(kCloud, "tf",
               "no transform from '" + lidar_frame + "' (" + topicName(kCloud) + ") to '" +
-                  camera_frame + "' (" + topicName(kLeftImage) + ") at sweep stamp " +
-                  stampText(match.sweep_stamp) + " within " +
+                  camera_frame + "' (" + topicName(kLeftImage) + ") at " +
+                  stampText(extrinsics_stamp) + " within " +
                   std::to_string(node_params_.tf_timeout) + " s: " + e.what() + "; frame skipped");
     return;
   }
@@ -178,7 +184,7 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   try {
     conversions::stereoPairToCore(set.left, set.right, input.left, input.right, &pair_note);
     input.camera = conversions::stereoCameraFromInfo(*set.left_info, *set.right_info);
-    cloud = conversions::cloudFromMsg(cloud_msg);
+    cloud = conversions::cloudFromMsg(cloud_msg, node_params_.max_point_time);
   } catch (const std::exception& e) {  // ConversionError, and anything OpenCV lets through
     ++counters_.invalid;
     log_.warn("input set", "convert",
@@ -212,6 +218,19 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
                   ", the prior will be coarse (publish the driver's ring field, or set "
                   "~num_rings to the sensor's beam count)");
   }
+  report.point_time_field = conversions::pointTimeFieldName(cloud.time_field);
+  report.bad_times = cloud.bad_times;
+  if (cloud.bad_times > 0) {
+    log_.warn(kCloud, "time",
+              topicName(kCloud) + ": " + std::to_string(cloud.bad_times) + " of " +
+                  std::to_string(cloud.cloud.size()) + " points of the sweep at " +
+                  stampText(match.sweep_stamp) + " have a '" + report.point_time_field +
+                  "' time that is NaN or more than ~max_point_time = " +
+                  std::to_string(node_params_.max_point_time) + " s from the stamp (e.g. " +
+                  std::to_string(cloud.bad_time_example) +
+                  " s): their time is not used (wrong unit or clock?)");
+  }
+  if (!node_params_.fixed_frame.empty() && !compensateEgoMotion(match, cloud, report)) return;
   input.cloud = std::move(cloud.cloud);
   report.cloud_points = static_cast<int>(input.cloud.size());
   report.invalid_points = cloud.non_finite + cloud.implausible;
@@ -231,6 +250,42 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
                        << result.stats.total_ms << " ms");
   report.method = methodName(pipeline.params().method);
   outputs_.publish(match, input.camera, input.left, result, pipeline.params(), report);
+}
+
+bool FusionWorker::compensateEgoMotion(const InputMatch& match,
+                                       conversions::CloudConversion& cloud, FrameReport& report) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string& lidar_frame = match.sweep->header.frame_id;
+  const std::string& fixed_frame = node_params_.fixed_frame;
+  const std::vector<double> times =
+      motionSampleTimes(cloud.cloud, cloud.has_time, node_params_.motion_samples);
+  try {
+    // One bounded wait for the latest instant needed; the samples are then looked up at once.
+    const ros::Time latest =
+        std::max(match.image_stamp, match.sweep_stamp + ros::Duration(times.back()));
+    std::string why;
+    if (!tf_buffer_.canTransform(fixed_frame, lidar_frame, latest,
+                                 ros::Duration(node_params_.tf_timeout), &why)) {
+      throw tf2::TransformException("no transform from '" + lidar_frame + "' to '" + fixed_frame +
+                                    "' at " + stampText(latest) + " within " +
+                                    std::to_string(node_params_.tf_timeout) + " s: " + why);
+    }
+    compensateMotion(cloud.cloud, sweepMotionFromTf(tf_buffer_, lidar_frame, fixed_frame,
+                                                     match.sweep_stamp, match.image_stamp, times));
+    report.motion_compensated = true;
+  } catch (const tf2::TransformException& e) {
+    ++counters_.motion_failures;
+    const bool skip = node_params_.motion_failure == "skip";
+    log_.warn(kCloud, "egomotion",
+              std::string("ego-motion compensation of the sweep at ") +
+                  stampText(match.sweep_stamp) + " to the images at " +
+                  stampText(match.image_stamp) + " failed: " + e.what() +
+                  (skip ? "; frame skipped (~motion_failure: skip)"
+                        : "; frame processed uncompensated (~motion_failure: uncompensated)"));
+    if (skip) return false;
+  }
+  report.motion_ms = msSince(start);
+  return true;
 }
 
 }  // namespace lidar_stereo_fusion

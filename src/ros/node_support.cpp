@@ -53,6 +53,17 @@ NodeParams NodeParams::read(const ros::NodeHandle& pnh) {
   readChecked(
       pnh, "worker_nice", p.worker_nice, [](int v) { return v >= 0 && v <= 19; },
       "must be in [0, 19]");
+  readChecked(pnh, "fixed_frame", p.fixed_frame, any, "");
+  readChecked(
+      pnh, "motion_samples", p.motion_samples, [](int v) { return v >= 1 && v <= 100; },
+      "must be in [1, 100]");
+  readChecked(
+      pnh, "motion_failure", p.motion_failure,
+      [](const std::string& v) { return v == "uncompensated" || v == "skip"; },
+      "must be 'uncompensated' or 'skip'");
+  readChecked(
+      pnh, "max_point_time", p.max_point_time, [](double v) { return v > 0.0 && v <= 10.0; },
+      "must be in (0, 10] s");
   readChecked(pnh, "diagnostics/min_rate", p.diag_min_rate, non_negative, "must be >= 0 [Hz]");
   readChecked(pnh, "diagnostics/max_rate", p.diag_max_rate, positive, "must be > 0 [Hz]");
   readChecked(pnh, "diagnostics/max_latency", p.diag_max_latency, positive, "must be > 0 [s]");
@@ -69,6 +80,7 @@ CounterSnapshot Counters::snapshot() const {
   s.out_of_order = out_of_order;
   s.errors = errors;
   s.rate_limited = rate_limited;
+  s.motion_failures = motion_failures;
   return s;
 }
 

@@ -55,6 +55,10 @@ FusionStatsPtr makeStatsMsg(const std_msgs::Header& header, const FrameStats& s,
   msg->rings_recovered = report.rings.source != RingSource::kField;
   msg->ring_method = ringSourceName(report.rings.source);
   msg->rings_plausible = report.rings.plausible;
+  msg->point_time_field = report.point_time_field;
+  msg->points_bad_time = report.bad_times;
+  msg->motion_compensated = report.motion_compensated;
+  msg->motion_ms = static_cast<float>(report.motion_ms);
   msg->prior_coverage = static_cast<float>(s.prior_coverage);
   msg->output_coverage = static_cast<float>(s.output_coverage);
   msg->processed_frames = c.processed;
@@ -65,6 +69,7 @@ FusionStatsPtr makeStatsMsg(const std_msgs::Header& header, const FrameStats& s,
   msg->out_of_order = c.out_of_order;
   msg->processing_errors = c.errors;
   msg->rate_limited = c.rate_limited;
+  msg->motion_failures = c.motion_failures;
   return msg;
 }
 
@@ -289,6 +294,7 @@ void OutputPublisher::diagnoseProcessing(diagnostic_updater::DiagnosticStatusWra
   stat.add("dropped frames", c.dropped);
   stat.add("unmatched frames", c.unmatched);
   stat.add("tf failures", c.tf_failures);
+  stat.add("ego-motion failures", c.motion_failures);
   stat.add("invalid inputs", c.invalid);
   stat.add("out of order", c.out_of_order);
   stat.add("processing errors", c.errors);

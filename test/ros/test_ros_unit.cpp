@@ -270,7 +270,8 @@ TEST(Conversions, VelodyneLayoutWithAnyNumericTypes) {
                                     {"ring", ring},
                                     {"time", time}},
                                    {{1.5, -2.25, 0.5, 200, 7, 3}, {10.0, 0.0, -1.0, 3, 0, 0}});
-        const conv::CloudConversion out = conv::cloudFromMsg(msg);
+        // A time of 3 s (a whole number for the integer types) is plausible up to 10 s.
+        const conv::CloudConversion out = conv::cloudFromMsg(msg, 10.0);
         ASSERT_EQ(out.cloud.size(), 2u);
         EXPECT_TRUE(out.has_ring);
         EXPECT_TRUE(out.has_time);

@@ -41,6 +41,9 @@ class CameraInfoError : public ConversionError {
   bool left;
 };
 
+/// True on a big-endian host (messages say their byte order in is_bigendian).
+bool hostIsBigEndian();
+
 /// Image encodings accepted for the stereo pair: bgra8 (ZED), rgba8, bgr8, rgb8, mono8.
 const std::vector<std::string>& supportedImageEncodings();
 
@@ -69,11 +72,35 @@ void stereoPairToCore(const sensor_msgs::ImageConstPtr& left,
 StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
                                   const sensor_msgs::CameraInfo& right);
 
+/// Where a sweep keeps each point's measurement time. One rule for every driver: the first field
+/// present in this order is read, and LidarPoint::time is the offset [s] of the point's time from
+/// the cloud's header stamp, whatever instant of the sweep the stamp is (start, end or middle).
+enum class PointTimeField {
+  kNone,         ///< no per-point time: every point has the stamp's time
+  kTime,         ///< `time`: s relative to the stamp (velodyne_pointcloud, float32)
+  kT,            ///< `t`: ns relative to the stamp (Ouster, uint32)
+  kOffsetTime,   ///< `offset_time`: ns relative to the stamp (Livox, uint32)
+  kTimestamp,    ///< `timestamp`: absolute s (Hesai, float64)
+  kTimeSecNsec,  ///< `time_sec` + `time_nsec`: absolute s and ns (Luminar, uint32 each)
+};
+
+/// The field's name as in the message ("time", "t", ..., "time_sec + time_nsec", "none").
+const char* pointTimeFieldName(PointTimeField field);
+
+/// [s] A point time farther than this from the stamp is implausible by default (two revolutions of
+/// a 10 Hz LiDAR): a wrong unit or a broken clock, not a measurement.
+constexpr double kDefaultMaxPointTime = 0.2;
+
 /// Result of converting a sensor_msgs/PointCloud2 sweep.
 struct CloudConversion {
   LidarCloud cloud;       ///< finite points only, in the cloud's frame [m]
   bool has_ring = false;  ///< the message had a `ring` field (points carry it)
-  bool has_time = false;  ///< the message had a `time` field [s within the sweep]
+  bool has_time = false;  ///< the message had a per-point time field (time_field)
+  PointTimeField time_field = PointTimeField::kNone;
+  /// Points whose time was NaN / inf or farther than max_point_time from the stamp: they keep
+  /// time 0 (the stamp's), and the caller names them; bad_time_example is the first such value.
+  int bad_times = 0;
+  double bad_time_example = 0.0;
   int total_points = 0;   ///< width * height of the message
   int non_finite = 0;     ///< points skipped because x, y or z was NaN / inf
   int implausible = 0;    ///< points skipped because |x|, |y| or |z| > kMaxCoordinate
@@ -83,7 +110,7 @@ struct CloudConversion {
 constexpr double kMaxCoordinate = 1e4;
 
 /// Checks the layout of a cloud without reading its points: x, y, z fields present as FLOAT32 or
-/// FLOAT64, the fields read (x, y, z, intensity, ring, time) with count 1 and a numeric type,
+/// FLOAT64, the fields read (x, y, z, intensity, ring, the time fields) with count 1 and a numeric type,
 /// point_step / row_step / data size consistent, little-endian. Returns an empty string when
 /// usable, else the problem.
 std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg);
@@ -93,10 +120,12 @@ std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg);
 std::string checkCloudFieldTypes(const sensor_msgs::PointCloud2& msg);
 
 /// Reads a sweep as velodyne_pointcloud publishes it (x, y, z, intensity, ring, time) or any other
-/// layout with at least x, y, z. `intensity`, `ring` and `time` are optional and may have any
-/// numeric datatype (float32/64, (u)int8/16/32). Non-finite points are skipped and counted.
-/// Throws ConversionError when checkCloudLayout() fails.
-CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg);
+/// layout with at least x, y, z. `intensity`, `ring` and the time fields (PointTimeField) are
+/// optional and may have any numeric datatype (float32/64, (u)int8/16/32). Non-finite points are
+/// skipped and counted; point times beyond `max_point_time` [s] of the stamp, or NaN, are counted in
+/// bad_times and not used. Throws ConversionError when checkCloudLayout() fails.
+CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg,
+                             double max_point_time = kDefaultMaxPointTime);
 
 /// Writes a core cloud as PointCloud2 with float32 x, y, z, intensity, uint16 ring, float32 time
 /// (the velodyne_pointcloud layout). Used by tests and tools.

@@ -28,6 +28,7 @@
 
 #include "lidar_stereo_fusion/FusionConfig.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/ros/conversions.h"
 #include "lidar_stereo_fusion/ros/input_gate.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 #include "lidar_stereo_fusion/ros/output_publisher.h"
@@ -46,6 +47,10 @@ class FusionWorker {
   void reconfigureCb(FusionConfig& config, uint32_t level);
   void workerLoop();
   void processMatch(const InputMatch& match, FusionPipeline& pipeline);
+  /// Moves the sweep's points to the image stamp through ~fixed_frame (ego_motion.h). On a TF
+  /// failure: counted and warned; false when the frame is then skipped (~motion_failure: skip).
+  bool compensateEgoMotion(const InputMatch& match, conversions::CloudConversion& cloud,
+                           FrameReport& report);
   std::string topicName(const std::string& relative) const { return nh_.resolveName(relative); }
 
   ros::NodeHandle nh_, pnh_;

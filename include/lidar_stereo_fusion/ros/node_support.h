@@ -46,6 +46,16 @@ struct NodeParams {
   /// uses every core, and ROS callbacks, nodelet bond heartbeats and drivers in the same machine
   /// must still be served on time. 0 = same priority as the callbacks.
   int worker_nice = 10;
+  /// Ego-motion compensation: the frame TF holds the rig's motion in (e.g. `odom`); every point
+  /// is moved from its measurement time to the left image's stamp through it. Empty = off.
+  std::string fixed_frame;
+  int motion_samples = 5;  ///< TF lookups per sweep, evenly over its point times (>= 1)
+  /// What a frame whose ego-motion TF is missing or stale gets: "uncompensated" (processed as
+  /// without fixed_frame, counted and warned) or "skip" (counted and warned).
+  std::string motion_failure = "uncompensated";
+  /// [s] per-point times farther than this from the sweep's stamp, or NaN, are named, counted and
+  /// not used (the point keeps the stamp's time).
+  double max_point_time = 0.2;
   double diag_min_rate = 1.0;     ///< [Hz] diagnostics: lowest acceptable output rate
   double diag_max_rate = 100.0;   ///< [Hz] diagnostics: highest acceptable output rate
   double diag_max_latency = 2.0;  ///< [s] diagnostics: largest acceptable stamp -> publish delay
@@ -58,16 +68,16 @@ struct NodeParams {
 /// A copy of the counters at one moment (FusionStats, diagnostics).
 struct CounterSnapshot {
   uint32_t processed = 0, dropped = 0, unmatched = 0, tf_failures = 0, invalid = 0,
-           out_of_order = 0, errors = 0, rate_limited = 0;
+           out_of_order = 0, errors = 0, rate_limited = 0, motion_failures = 0;
   uint32_t problems() const {
-    return dropped + unmatched + tf_failures + invalid + out_of_order + errors;
+    return dropped + unmatched + tf_failures + invalid + out_of_order + errors + motion_failures;
   }
 };
 
 /// Cumulative counters, written by every part without a lock.
 struct Counters {
   std::atomic<uint32_t> processed{0}, dropped{0}, unmatched{0}, tf_failures{0}, invalid{0},
-      out_of_order{0}, errors{0}, rate_limited{0};
+      out_of_order{0}, errors{0}, rate_limited{0}, motion_failures{0};
   CounterSnapshot snapshot() const;
 };
 

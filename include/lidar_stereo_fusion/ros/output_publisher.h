@@ -42,6 +42,10 @@ struct FrameReport {
   int cloud_points = 0;      ///< finite points of the sweep
   int invalid_points = 0;    ///< points dropped: NaN / inf, or beyond kMaxCoordinate
   RingRecovery rings;
+  std::string point_time_field = "none";  ///< conversions::pointTimeFieldName
+  int bad_times = 0;                      ///< points whose time was not used
+  bool motion_compensated = false;        ///< moved to the image stamp through ~fixed_frame
+  double motion_ms = 0;                   ///< TF sampling and moving the points
 };
 
 /// Latency [ms] from the image stamp to `publish_time` (ROS time). When ROS time restarted after
