@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -34,7 +36,8 @@ void SweepMotion::validate() const {
   }
   for (size_t i = 0; i < times.size(); ++i) {
     if (!std::isfinite(times[i])) {
-      throw std::invalid_argument("SweepMotion: sample " + std::to_string(i) + "'s time is not finite");
+      throw std::invalid_argument("SweepMotion: sample " + std::to_string(i) +
+                                  "'s time is not finite");
     }
     if (i > 0 && !(times[i] > times[i - 1])) {
       throw std::invalid_argument("SweepMotion: sample times must increase (sample " +
@@ -50,7 +53,8 @@ void SweepMotion::validate() const {
 Eigen::Isometry3d SweepMotion::at(double t) const {
   if (t <= times.front()) return target_from_lidar.front();
   if (t >= times.back()) return target_from_lidar.back();
-  const size_t i = static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
+  const size_t i =
+      static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
   const double s = (t - times[i - 1]) / (times[i] - times[i - 1]);
   return interpolate(target_from_lidar[i - 1], target_from_lidar[i], s);
 }
@@ -103,6 +107,52 @@ void compensateMotion(LidarCloud& cloud, const SweepMotion& motion) {
     p.y = static_cast<float>(q.y());
     p.z = static_cast<float>(q.z());
   }
+}
+
+int removePointsHiddenBeside(LidarCloud& cloud, const Eigen::Isometry3d& T_cam_lidar,
+                             const StereoCamera& camera) {
+  camera.validate();
+  struct Projected {
+    size_t index;
+    double azimuth, u, z;
+  };
+  std::map<int, std::vector<Projected>> rings;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const LidarPoint& p = cloud[i];
+    if (p.ring < 0 || !std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+    const Eigen::Vector3d c = T_cam_lidar * Eigen::Vector3d(p.x, p.y, p.z);
+    if (!(c.z() > 0.1)) continue;
+    const double u = camera.fx * c.x() / c.z() + camera.cx;
+    if (u < -0.5 || u >= camera.width - 0.5) continue;
+    rings[p.ring].push_back(
+        {i, std::atan2(static_cast<double>(p.y), static_cast<double>(p.x)), u, c.z()});
+  }
+  std::vector<char> hidden(cloud.size(), 0);
+  std::vector<double> cover(camera.width);
+  for (auto& [ring, points] : rings) {
+    std::sort(points.begin(), points.end(),
+              [](const Projected& a, const Projected& b) { return a.azimuth > b.azimuth; });
+    std::fill(cover.begin(), cover.end(), std::numeric_limits<double>::infinity());
+    for (size_t k = 0; k + 1 < points.size(); ++k) {
+      const Projected &a = points[k], &b = points[k + 1];
+      const double far = std::max(a.z, b.z);
+      if (std::abs(a.z - b.z) > std::max(0.3, 0.05 * far)) continue;  // not one surface
+      const int first = std::max(0, static_cast<int>(std::ceil(std::min(a.u, b.u))));
+      const int last = std::min(camera.width - 1, static_cast<int>(std::floor(std::max(a.u, b.u))));
+      for (int col = first; col <= last; ++col) cover[col] = std::min(cover[col], far);
+    }
+    for (const Projected& p : points) {
+      const int col = std::clamp(static_cast<int>(std::floor(p.u + 0.5)), 0, camera.width - 1);
+      if (cover[col] < p.z - std::max(0.5, 0.1 * p.z)) hidden[p.index] = 1;
+    }
+  }
+  size_t kept = 0;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    if (!hidden[i]) cloud[kept++] = cloud[i];
+  }
+  const int removed = static_cast<int>(cloud.size() - kept);
+  cloud.resize(kept);
+  return removed;
 }
 
 }  // namespace lidar_stereo_fusion

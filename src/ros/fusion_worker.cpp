@@ -230,7 +230,9 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
                   std::to_string(cloud.bad_time_example) +
                   " s): their time is not used (wrong unit or clock?)");
   }
-  if (!node_params_.fixed_frame.empty() && !compensateEgoMotion(match, cloud, report)) return;
+  if (!node_params_.fixed_frame.empty() && !compensateEgoMotion(match, input, cloud, report)) {
+    return;
+  }
   input.cloud = std::move(cloud.cloud);
   report.cloud_points = static_cast<int>(input.cloud.size());
   report.invalid_points = cloud.non_finite + cloud.implausible;
@@ -252,7 +254,7 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   outputs_.publish(match, input.camera, input.left, result, pipeline.params(), report);
 }
 
-bool FusionWorker::compensateEgoMotion(const InputMatch& match,
+bool FusionWorker::compensateEgoMotion(const InputMatch& match, const FusionInput& input,
                                        conversions::CloudConversion& cloud, FrameReport& report) {
   const auto start = std::chrono::steady_clock::now();
   const std::string& lidar_frame = match.sweep->header.frame_id;
@@ -272,6 +274,8 @@ bool FusionWorker::compensateEgoMotion(const InputMatch& match,
     }
     compensateMotion(cloud.cloud, sweepMotionFromTf(tf_buffer_, lidar_frame, fixed_frame,
                                                      match.sweep_stamp, match.image_stamp, times));
+    // Measured from elsewhere than the camera: what it cannot see beside near objects goes.
+    removePointsHiddenBeside(cloud.cloud, input.T_cam_lidar, input.camera);
     report.motion_compensated = true;
   } catch (const tf2::TransformException& e) {
     ++counters_.motion_failures;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -21,15 +22,36 @@ void appendLinear(std::vector<double>& out, double first, double last, int count
   }
 }
 
+/// When each firing happens, and where the LiDAR is then.
+struct SweepClock {
+  /// Static sweep: time = azimuth / 360 deg * period, one pose. Moving: the Velodyne's clockwise
+  /// spin (moving_time), each firing cast from pose_at(time).
+  bool moving = false;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  double front_time = 0.0;
+  const std::function<Eigen::Isometry3d(double)>* pose_at = nullptr;
+};
+
+/// Clockwise seen from above: azimuth a in (-180, 180] deg is reached at front_time - a / 360 * T.
+double movingTime(double azimuth_deg, double front_time, double period) {
+  const double a = azimuth_deg > 180.0 ? azimuth_deg - 360.0 : azimuth_deg;
+  return front_time - a / 360.0 * period;
+}
+
 /// The rays of one ring, in azimuth order.
-void castRing(const Scene& scene, const LidarModel& model, const Eigen::Isometry3d& T_world_lidar,
+void castRing(const Scene& scene, const LidarModel& model, const SweepClock& clock,
               const LidarNoise& noise, int ring, LidarCloud& points,
               std::vector<Eigen::Vector3d>& truth) {
   const double elevation = model.elevations_deg[ring] * kDegToRad;
   const int firings = static_cast<int>(std::lround(360.0 / model.azimuth_step_deg));
-  const Eigen::Vector3d origin = T_world_lidar.translation();
   for (int j = 0; j < firings; ++j) {
-    const double azimuth = (j + 0.5) * model.azimuth_step_deg * kDegToRad;  // never exactly 0
+    const double azimuth_deg = (j + 0.5) * model.azimuth_step_deg;  // never exactly 0
+    const double azimuth = azimuth_deg * kDegToRad;
+    const double time = clock.moving
+                            ? movingTime(azimuth_deg, clock.front_time, model.sweep_period)
+                            : (j + 0.5) / firings * model.sweep_period;
+    const Eigen::Isometry3d T_world_lidar = clock.moving ? (*clock.pose_at)(time) : clock.pose;
+    const Eigen::Vector3d origin = T_world_lidar.translation();
     const Eigen::Vector3d dir_lidar(std::cos(elevation) * std::cos(azimuth),
                                     std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
     const Eigen::Vector3d dir_world = T_world_lidar.linear() * dir_lidar;
@@ -55,7 +77,7 @@ void castRing(const Scene& scene, const LidarModel& model, const Eigen::Isometry
     p.intensity = static_cast<float>(std::clamp(
         scene.material(hit.material).lidar_reflectivity * std::max(cos_incidence, 0.1), 0.0, 1.0));
     p.ring = ring;
-    p.time = static_cast<float>((j + 0.5) / firings * model.sweep_period);
+    p.time = static_cast<float>(time);
     points.push_back(p);
     truth.push_back(hit.point);
   }
@@ -107,8 +129,10 @@ void LidarModel::validate() const {
   if (!(sweep_period > 0.0)) throw std::invalid_argument("sim::LidarModel: sweep_period <= 0");
 }
 
-SimulatedSweep simulateSweep(const Scene& scene, const LidarModel& model,
-                             const Eigen::Isometry3d& T_world_lidar, const LidarNoise& noise) {
+namespace {
+
+SimulatedSweep castSweep(const Scene& scene, const LidarModel& model, const SweepClock& clock,
+                         const LidarNoise& noise) {
   model.validate();
   if (!(noise.range_sigma_m >= 0.0) ||
       !(noise.dropout_probability >= 0.0 && noise.dropout_probability < 1.0)) {
@@ -120,7 +144,7 @@ SimulatedSweep simulateSweep(const Scene& scene, const LidarModel& model,
   std::vector<std::vector<Eigen::Vector3d>> ring_truth(rings);
 #pragma omp parallel for schedule(dynamic)
   for (int r = 0; r < rings; ++r) {
-    castRing(scene, model, T_world_lidar, noise, r, ring_points[r], ring_truth[r]);
+    castRing(scene, model, clock, noise, r, ring_points[r], ring_truth[r]);
   }
   SimulatedSweep sweep;
   for (int r = 0; r < rings; ++r) {
@@ -128,6 +152,25 @@ SimulatedSweep simulateSweep(const Scene& scene, const LidarModel& model,
     sweep.true_points.insert(sweep.true_points.end(), ring_truth[r].begin(), ring_truth[r].end());
   }
   return sweep;
+}
+
+}  // namespace
+
+SimulatedSweep simulateSweep(const Scene& scene, const LidarModel& model,
+                             const Eigen::Isometry3d& T_world_lidar, const LidarNoise& noise) {
+  SweepClock clock;
+  clock.pose = T_world_lidar;
+  return castSweep(scene, model, clock, noise);
+}
+
+SimulatedSweep simulateMovingSweep(const Scene& scene, const LidarModel& model,
+                                   const std::function<Eigen::Isometry3d(double)>& pose_at,
+                                   double front_time, const LidarNoise& noise) {
+  SweepClock clock;
+  clock.moving = true;
+  clock.front_time = front_time;
+  clock.pose_at = &pose_at;
+  return castSweep(scene, model, clock, noise);
 }
 
 }  // namespace sim

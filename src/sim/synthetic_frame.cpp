@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -125,6 +126,8 @@ void SyntheticParams::validate() const {
   require(speed >= 0 && std::isfinite(speed), "speed must be >= 0 [m/s]");
   require(frame_period > 0, "frame_period must be > 0 [s]");
   require(camera_height > 0, "camera_height must be > 0 [m]");
+  require(std::isfinite(lidar_time_offset) && std::abs(lidar_time_offset) <= frame_period,
+          "lidar_time_offset must be within one frame_period of the image instant [s]");
 }
 
 SyntheticParams SyntheticParams::resized(int new_width, int new_height) const {
@@ -163,6 +166,10 @@ Eigen::Isometry3d SyntheticParams::cameraFromLidar() const {
   return t;
 }
 
+Eigen::Isometry3d SyntheticParams::worldFromCamera(double t) const {
+  return Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, speed * t));
+}
+
 LidarModel SyntheticParams::lidarModel() const {
   LidarModel model = LidarModel::forRings(rings);
   if (azimuth_step_deg > 0.0) model.azimuth_step_deg = azimuth_step_deg;
@@ -177,9 +184,10 @@ SyntheticFrame renderFrame(const Scene& scene, const SyntheticParams& params, in
   frame.camera = params.camera();
   frame.T_cam_lidar = params.cameraFromLidar();
   frame.stamp = index * params.frame_period;
-  const Eigen::Vector3d left_centre(0.0, 0.0, params.speed * params.frame_period * index);
+  frame.cloud_stamp = frame.stamp;
+  frame.T_world_cam = params.worldFromCamera(frame.stamp);
+  const Eigen::Vector3d left_centre = frame.T_world_cam.translation();
   const Eigen::Vector3d right_centre = left_centre + Eigen::Vector3d(params.baseline, 0.0, 0.0);
-  frame.T_world_cam = Eigen::Translation3d(left_centre) * Eigen::Isometry3d::Identity();
 
   const uint64_t frame_seed = hashCombine(params.seed, static_cast<uint64_t>(index));
   frame.left = renderView(scene, params, left_centre, left_centre, hashCombine(frame_seed, 0x1ef7));
@@ -191,8 +199,17 @@ SyntheticFrame renderFrame(const Scene& scene, const SyntheticParams& params, in
   noise.range_sigma_m = params.range_noise_sigma;
   noise.dropout_probability = params.dropout_probability;
   noise.seed = hashCombine(frame_seed, 0x11da7);
-  const SimulatedSweep sweep =
-      simulateSweep(scene, params.lidarModel(), frame.T_world_cam * frame.T_cam_lidar, noise);
+  SimulatedSweep sweep;
+  if (params.moving_sweep) {
+    const double period = params.frame_period;
+    frame.cloud_stamp = frame.stamp + params.lidar_time_offset + 0.5 * period;
+    const std::function<Eigen::Isometry3d(double)> pose_at = [&](double t) {
+      return params.worldFromCamera(frame.cloud_stamp + t) * frame.T_cam_lidar;
+    };
+    sweep = simulateMovingSweep(scene, params.lidarModel(), pose_at, -0.5 * period, noise);
+  } else {
+    sweep = simulateSweep(scene, params.lidarModel(), frame.T_world_cam * frame.T_cam_lidar, noise);
+  }
   frame.cloud = sweep.cloud;
   frame.truth.resize(sweep.true_points.size());
 #pragma omp parallel for schedule(dynamic, 256)

@@ -75,9 +75,11 @@ TEST(MotionCompensation, TranslationMovesEveryPointToTheTargetInstant) {
   const SweepMotion motion =
       constantVelocityMotion(v, Eigen::Vector3d::Zero(), target, sampleTimes(0.0, 0.1, 5));
   LidarCloud cloud;
-  const std::vector<Eigen::Vector3d> world = {{10.0, 2.0, 0.5}, {-5.0, 3.0, 1.0}, {8.0, -4.0, -1.5}};
+  const std::vector<Eigen::Vector3d> world = {
+      {10.0, 2.0, 0.5}, {-5.0, 3.0, 1.0}, {8.0, -4.0, -1.5}};
   const std::vector<double> times = {0.0, 0.0375, 0.1};
-  for (size_t i = 0; i < world.size(); ++i) cloud.push_back(pointAt(world[i] - v * times[i], times[i]));
+  for (size_t i = 0; i < world.size(); ++i)
+    cloud.push_back(pointAt(world[i] - v * times[i], times[i]));
   compensateMotion(cloud, motion);
   for (size_t i = 0; i < world.size(); ++i) {
     const Eigen::Vector3d expected = world[i] - v * target;

@@ -52,4 +52,15 @@ SweepMotion constantVelocityMotion(const Eigen::Vector3d& velocity,
 /// them). Throws std::invalid_argument if motion.validate() fails.
 void compensateMotion(LidarCloud& cloud, const SweepMotion& motion);
 
+/// A compensated sweep was measured from up to a metre ahead of (or behind) the camera: beside a
+/// near object it holds background the camera cannot see, which lands inside the object's
+/// silhouette in the image. Algorithm 1 removes only points hidden by a foreground above and below
+/// them; these are hidden beside. Per ring (points with ring < 0 are left alone), the segments
+/// between consecutive points in azimuth order that lie on one surface (depths within 5 %, at
+/// least 0.3 m) cover image columns at their farther depth; a point whose column is covered by a
+/// segment nearer than its own depth by more than 10 % (at least 0.5 m) is removed. Returns the
+/// number removed. Throws std::invalid_argument for an invalid camera.
+int removePointsHiddenBeside(LidarCloud& cloud, const Eigen::Isometry3d& T_cam_lidar,
+                             const StereoCamera& camera);
+
 }  // namespace lidar_stereo_fusion

@@ -47,10 +47,11 @@ class FusionWorker {
   void reconfigureCb(FusionConfig& config, uint32_t level);
   void workerLoop();
   void processMatch(const InputMatch& match, FusionPipeline& pipeline);
-  /// Moves the sweep's points to the image stamp through ~fixed_frame (ego_motion.h). On a TF
+  /// Moves the sweep's points to the image stamp through ~fixed_frame (ego_motion.h) and removes
+  /// those the camera cannot see beside near objects (removePointsHiddenBeside). On a TF
   /// failure: counted and warned; false when the frame is then skipped (~motion_failure: skip).
-  bool compensateEgoMotion(const InputMatch& match, conversions::CloudConversion& cloud,
-                           FrameReport& report);
+  bool compensateEgoMotion(const InputMatch& match, const FusionInput& input,
+                           conversions::CloudConversion& cloud, FrameReport& report);
   std::string topicName(const std::string& relative) const { return nh_.resolveName(relative); }
 
   ros::NodeHandle nh_, pnh_;

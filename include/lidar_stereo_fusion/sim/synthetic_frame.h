@@ -45,6 +45,13 @@ struct SyntheticParams {
   double speed = 10.0;          ///< [m/s]
   double frame_period = 0.1;    ///< [s] between frames (one LiDAR revolution)
   double camera_height = 1.65;  ///< above the street's ground [m]
+  /// The LiDAR moves during its sweep: each firing is cast from the rig's pose at its own time, and
+  /// the LiDAR spins clockwise as a Velodyne does (sim::simulateMovingSweep). false: the whole sweep
+  /// is cast from the image instant's pose (a rig standing still, or a motion-compensated sweep).
+  bool moving_sweep = false;
+  /// [s] with moving_sweep: the LiDAR faces straight ahead this long after the image instant (0: the
+  /// camera is triggered by the LiDAR, as KITTI's; a free-running ZED is up to a period away).
+  double lidar_time_offset = 0.0;
 
   /// Throws std::invalid_argument naming the first impossible value.
   void validate() const;
@@ -54,6 +61,9 @@ struct SyntheticParams {
   StereoCamera camera() const;
   /// LiDAR frame -> left optical frame.
   Eigen::Isometry3d cameraFromLidar() const;
+  /// Left optical frame at time `t` [s] (frame k's image instant is k * frame_period) -> street
+  /// frame: the rig drives along the street's +z at `speed`.
+  Eigen::Isometry3d worldFromCamera(double t) const;
   /// The LiDAR model with this frame's ring count and azimuth step.
   LidarModel lidarModel() const;
 };
@@ -80,7 +90,11 @@ struct SyntheticFrame {
   /// 255 where the surface point at the pixel centre lies within the LiDAR's elevation range as
   /// seen from the LiDAR (ignoring occlusion): where KITTI's accumulated-LiDAR ground truth exists.
   cv::Mat1b lidar_fov;
-  double stamp = 0.0;  ///< [s] since the first frame
+  double stamp = 0.0;  ///< [s] since the first frame: the image instant
+  /// [s] the sweep's stamp, same base: the image instant for a static sweep; with moving_sweep the
+  /// sweep's end (velodyne_driver's convention), image instant + lidar_time_offset + period / 2.
+  /// Point times are relative to it.
+  double cloud_stamp = 0.0;
 };
 
 /// Renders frame `index` of `scene`: the left camera at (0, 0, speed * frame_period * index) of
