@@ -48,6 +48,11 @@ add_rostest(test/ros/fusion_node.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_approx_sync.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_max_rate.test DEPENDENCIES test_fusion_node)
 
+# Issue 23: a moving rig's bag (ego-motion on /tf) through the nodelet with and without
+# ~fixed_frame, scored against the exact depth at the image instant.
+lsf_add_ros_test_node(test_moving_rig test/ros/test_moving_rig.cpp test/ros/child_process.cpp)
+add_rostest(test/ros/moving_rig.test DEPENDENCIES test_moving_rig)
+
 # Issue 10: depth_image_proc / stereo_image_proc consume the outputs by remapping only; dynparam
 # refusals are visible; silent inputs are named.
 lsf_add_ros_test_node(test_ros_conventions test/ros/test_ros_conventions.cpp test/ros/run_command.cpp)
