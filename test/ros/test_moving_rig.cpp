@@ -6,18 +6,20 @@
 // (core/motion_compensation.h); the uncompensated one shows what the motion costs.
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <map>
 #include <mutex>
 #include <string>
 #include <vector>
 
+#include <cv_bridge/cv_bridge.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <rosgraph_msgs/Log.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
-#include <cv_bridge/cv_bridge.h>
 
 #include "child_process.h"
 #include "lidar_stereo_fusion/FusionStats.h"
@@ -105,6 +107,17 @@ class MovingRig : public ::testing::Test {
     std::lock_guard<std::mutex> lock(mutex_);
     stats_[ns][msg->header.stamp] = *msg;
   }
+  void logCb(const rosgraph_msgs::LogConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    logs_.push_back(msg->msg);
+  }
+  bool logged(const std::string& a, const std::string& b) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& l : logs_) {
+      if (l.find(a) != std::string::npos && l.find(b) != std::string::npos) return true;
+    }
+    return false;
+  }
   bool have(const std::string& ns, const ros::Time& stamp) {
     std::lock_guard<std::mutex> lock(mutex_);
     return depths_[ns].count(stamp) > 0 && stats_[ns].count(stamp) > 0;
@@ -114,6 +127,7 @@ class MovingRig : public ::testing::Test {
   std::mutex mutex_;
   std::map<std::string, std::map<ros::Time, cv::Mat1f>> depths_;
   std::map<std::string, std::map<ros::Time, lidar_stereo_fusion::FusionStats>> stats_;
+  std::vector<std::string> logs_;
 };
 
 TEST_F(MovingRig, CompensatedDepthMatchesTheTruthAtTheImageInstant) {
@@ -127,9 +141,12 @@ TEST_F(MovingRig, CompensatedDepthMatchesTheTruthAtTheImageInstant) {
   writeBag(bag_path, frames, p, base);
 
   std::vector<ros::Subscriber> subs;
-  for (const std::string ns : {"/moving_comp", "/moving_raw"}) {
+  ros::Subscriber rosout = nh_.subscribe<rosgraph_msgs::Log>(
+      "/rosout", 100, [this](const rosgraph_msgs::LogConstPtr& m) { logCb(m); });
+  for (const std::string ns : {"/moving_comp", "/moving_raw", "/moving_skip"}) {
     subs.push_back(nh_.subscribe<sensor_msgs::Image>(
-        ns + "/depth/image_rect", 5, [this, ns](const sensor_msgs::ImageConstPtr& m) { depthCb(ns, m); }));
+        ns + "/depth/image_rect", 5,
+        [this, ns](const sensor_msgs::ImageConstPtr& m) { depthCb(ns, m); }));
     subs.push_back(nh_.subscribe<lidar_stereo_fusion::FusionStats>(
         ns + "/stats", 5,
         [this, ns](const lidar_stereo_fusion::FusionStatsConstPtr& m) { statsCb(ns, m); }));
@@ -147,9 +164,10 @@ TEST_F(MovingRig, CompensatedDepthMatchesTheTruthAtTheImageInstant) {
   }
   pubs["/velodyne_points"] = nh_.advertise<sensor_msgs::PointCloud2>("/velodyne_points", 5);
   ASSERT_TRUE(lsf::test::waitFor(30.0, [&] {
-    return pubs["/velodyne_points"].getNumSubscribers() >= 2 &&
-           pubs["/stereo/left/image_rect_color"].getNumSubscribers() >= 2;
-  })) << "the nodelets did not subscribe to the inputs";
+    return pubs["/velodyne_points"].getNumSubscribers() >= 3 &&
+           pubs["/tf"].getNumSubscribers() >= 3 &&
+           pubs["/stereo/left/image_rect_color"].getNumSubscribers() >= 3;
+  })) << "the nodelets did not subscribe to the inputs and /tf";
 
   rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
   rosbag::View view(bag);
@@ -169,12 +187,17 @@ TEST_F(MovingRig, CompensatedDepthMatchesTheTruthAtTheImageInstant) {
       // up to ~tf_timeout (0.5 s in moving_rig.test).
       pubs[topic].publish(m.instantiate<sensor_msgs::PointCloud2>());
       const ros::Time stamp = image_stamps.back();
-      EXPECT_TRUE(lsf::test::waitFor(60.0, [&] {
-        return have("/moving_comp", stamp) && have("/moving_raw", stamp);
-      })) << "no output for the frame at " << stamp;
+      EXPECT_TRUE(lsf::test::waitFor(60.0,
+                                     [&] {
+                                       return have("/moving_comp", stamp) &&
+                                              have("/moving_raw", stamp) &&
+                                              have("/moving_skip", stamp);
+                                     }))
+          << "no output for the frame at " << stamp;
     }
   }
   ASSERT_EQ(image_stamps.size(), static_cast<size_t>(kFrames));
+  std::cerr << "played " << kFrames << " frames\n";
 
   for (int k = 0; k < kFrames; ++k) {
     const auto& f = frames[k];
@@ -203,12 +226,43 @@ TEST_F(MovingRig, CompensatedDepthMatchesTheTruthAtTheImageInstant) {
     const auto offline = depthMae(pipeline.process(input).depth, f);
     const auto comp = depthMae(depths_["/moving_comp"][stamp], f);
     const auto raw = depthMae(depths_["/moving_raw"][stamp], f);
-    std::cout << "frame " << k + 1 << ": depth MAE in the LiDAR's view, compensated " << comp.first
+    std::cerr << "frame " << k + 1 << ": depth MAE in the LiDAR's view, compensated " << comp.first
               << " m (offline " << offline.first << " m), uncompensated " << raw.first << " m\n";
     EXPECT_GT(comp.second, 0.95) << k;
     EXPECT_LT(comp.first, 1.1 * offline.first + 0.01) << k;
     EXPECT_GT(raw.first, 3.0 * comp.first) << k;
   }
+
+  // A frame whose ego-motion is not on TF (2 s after the last one): /moving_comp warns, naming
+  // the frames, and processes it uncompensated; /moving_skip (~motion_failure: skip) drops it.
+  const auto& f = frames[0];
+  const ros::Time image = image_stamps.back() + ros::Duration(2.0);
+  const ros::Time sweep = image + ros::Duration(f.cloud_stamp - f.stamp);
+  pubs["/stereo/left/camera_info"].publish(
+      lsf::test::cameraInfoMsg(f.camera, false, kCameraFrame, image));
+  pubs["/stereo/right/camera_info"].publish(
+      lsf::test::cameraInfoMsg(f.camera, true, kRightCameraFrame, image));
+  pubs["/stereo/left/image_rect_color"].publish(
+      lsf::test::imageMsg(f.left, "bgr8", kCameraFrame, image));
+  pubs["/stereo/right/image_rect_color"].publish(
+      lsf::test::imageMsg(f.right, "bgr8", kRightCameraFrame, image));
+  pubs["/velodyne_points"].publish(lsf::test::cloudMsg(f.cloud, kLidarFrame, sweep));
+  ASSERT_TRUE(
+      lsf::test::waitFor(60.0,
+                         [&] {
+                           return have("/moving_comp", image) && have("/moving_raw", image) &&
+                                  logged("ego-motion compensation", "(~motion_failure: skip)");
+                         }))
+      << "the frame without ego-motion was not processed by /moving_comp, or /moving_skip did not "
+         "say it skipped it";
+  std::cerr << "the frame without ego-motion was processed\n";
+  EXPECT_TRUE(logged("'odom'", "(~motion_failure: uncompensated)"));
+  EXPECT_TRUE(logged("'velodyne'", "(~motion_failure: uncompensated)"));
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto& failed = stats_["/moving_comp"][image];
+  EXPECT_FALSE(failed.motion_compensated);
+  EXPECT_EQ(failed.motion_failures, 1u);
+  EXPECT_EQ(depths_["/moving_skip"].count(image), 0u);
 }
 
 }  // namespace
