@@ -46,6 +46,15 @@ double zncc(const std::vector<float>& a, double a_norm, const std::vector<float>
   return norm > 0.0 ? dot / std::sqrt(a_norm * norm) : -1.0;
 }
 
+/// The median of a non-empty list (the mean of the middle two for an even count).
+double median(std::vector<double> values) {
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  double m = values[mid];
+  if (values.size() % 2 == 0) m = 0.5 * (m + *std::max_element(values.begin(), values.begin() + mid));
+  return m;
+}
+
 }  // namespace
 
 void PhotometricCheckParams::validate() const {
@@ -138,13 +147,8 @@ ShiftSummary summarizeShifts(const std::vector<double>& shifts, double within) {
     magnitudes.push_back(std::abs(s));
     if (std::abs(s) <= within) ++inside;
   }
-  const size_t mid = magnitudes.size() / 2;
-  std::nth_element(magnitudes.begin(), magnitudes.begin() + mid, magnitudes.end());
-  double median = magnitudes[mid];
-  if (magnitudes.size() % 2 == 0) {
-    median = 0.5 * (median + *std::max_element(magnitudes.begin(), magnitudes.begin() + mid));
-  }
-  summary.median_abs = median;
+  summary.median = median(shifts);
+  summary.median_abs = median(magnitudes);
   summary.fraction_within = static_cast<double>(inside) / static_cast<double>(shifts.size());
   return summary;
 }
@@ -153,12 +157,14 @@ std::string formatShiftTable(const std::vector<ShiftRow>& rows) {
   const bool any_after =
       std::any_of(rows.begin(), rows.end(), [](const ShiftRow& r) { return r.after.has_value(); });
   std::ostringstream out;
-  out << "| frame | scored px | median abs delta [px] | abs delta <= 0.5 px |";
-  if (any_after) out << " scored px (deskewed) | median abs delta [px] (deskewed) | abs delta <= 0.5 px (deskewed) |";
-  out << "\n|---|---:|---:|---:|" << (any_after ? "---:|---:|---:|" : "") << "\n";
+  out << "| frame | scored px | median delta [px] | median abs delta [px] | abs delta <= 0.5 px |";
+  if (any_after) {
+    out << " scored px, deskewed | median delta | median abs delta | abs delta <= 0.5 px |";
+  }
+  out << "\n|---|---:|---:|---:|---:|" << (any_after ? "---:|---:|---:|---:|" : "") << "\n";
   auto cells = [&out](const ShiftSummary& s) {
-    out << " " << s.count << " | " << std::fixed << std::setprecision(3) << s.median_abs << " | "
-        << std::setprecision(1) << 100.0 * s.fraction_within << " % |";
+    out << " " << s.count << " | " << std::fixed << std::setprecision(3) << s.median << " | "
+        << s.median_abs << " | " << std::setprecision(1) << 100.0 * s.fraction_within << " % |";
   };
   for (const ShiftRow& row : rows) {
     out << "| " << row.name << " |";
@@ -166,7 +172,7 @@ std::string formatShiftTable(const std::vector<ShiftRow>& rows) {
     if (row.after) {
       cells(*row.after);
     } else if (any_after) {
-      out << " - | - | - |";
+      out << " - | - | - | - |";
     }
     out << "\n";
   }

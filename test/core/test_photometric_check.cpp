@@ -46,6 +46,7 @@ TEST(PhotometricCheck, FindsAKnownSubPixelOffsetOfTheLidarDisparity) {
     for (const double shift : result.shifts) EXPECT_NEAR(shift, error, 0.06);
     const ShiftSummary summary = summarizeShifts(result.shifts);
     EXPECT_NEAR(summary.median_abs, std::abs(error), 0.06);
+    EXPECT_NEAR(summary.median, error, 0.06);
     EXPECT_EQ(summary.fraction_within, std::abs(error) <= 0.5 ? 1.0 : 0.0);
   }
 }
@@ -78,14 +79,17 @@ TEST(PhotometricCheck, FlatPatchesEdgesAndOutOfRangeShiftsAreNotScored) {
 TEST(PhotometricCheck, SummaryMedianAndShareAreExact) {
   const ShiftSummary s = summarizeShifts({-1.0, 0.25, 0.5, 2.0});
   EXPECT_EQ(s.count, 4);
+  EXPECT_EQ(s.median, 0.375);
   EXPECT_EQ(s.median_abs, 0.75);
   EXPECT_EQ(s.fraction_within, 0.5);
   EXPECT_EQ(summarizeShifts({-0.75, 3.0, 0.1}).median_abs, 0.75);
   EXPECT_EQ(summarizeShifts({}).count, 0);
   const std::string table = formatShiftTable({{"f", s, s}, {"g", s, std::nullopt}});
-  EXPECT_NE(table.find("| f | 4 | 0.750 | 50.0 % | 4 | 0.750 | 50.0 % |"), std::string::npos)
+  EXPECT_NE(table.find("| f | 4 | 0.375 | 0.750 | 50.0 % | 4 | 0.375 | 0.750 | 50.0 % |"),
+            std::string::npos)
       << table;
-  EXPECT_NE(table.find("| g | 4 | 0.750 | 50.0 % | - | - | - |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| g | 4 | 0.375 | 0.750 | 50.0 % | - | - | - | - |"), std::string::npos)
+      << table;
 }
 
 }  // namespace

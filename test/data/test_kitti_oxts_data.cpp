@@ -4,6 +4,9 @@
 // rear by about a sweep's travel and the front by the image's offset from the forward instant.
 // Missing data fails under CI=true and skips otherwise.
 #include <cmath>
+#include <iostream>
+#include <map>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -91,6 +94,92 @@ TEST(KittiOxtsData, DeskewMovesTheRearByASweepsTravelAndTheFrontByTheImageOffset
   EXPECT_GT(speed, 9.0);
   EXPECT_NEAR(front / n_front, speed * std::abs(image_after_front), 0.02);
   EXPECT_NEAR(rear / n_rear, speed * 0.5 * clock.period, 0.06);
+}
+
+/// Mean distance [m] from the points of `a` above the ground (z > -1.3 m), 3 to 30 m away and
+/// within 60 deg of the front, to their nearest point of `b`, counting those nearer than 0.5 m.
+double meanNearestDistance(const LidarCloud& a, const LidarCloud& b) {
+  constexpr double kCell = 0.5;
+  auto key = [](double x, double y, double z) {
+    return std::make_tuple(static_cast<int>(std::floor(x / kCell)),
+                           static_cast<int>(std::floor(y / kCell)),
+                           static_cast<int>(std::floor(z / kCell)));
+  };
+  std::map<std::tuple<int, int, int>, std::vector<Eigen::Vector3d>> grid;
+  for (const LidarPoint& p : b) {
+    if (p.z > -1.3f) grid[key(p.x, p.y, p.z)].emplace_back(p.x, p.y, p.z);
+  }
+  double sum = 0.0;
+  int n = 0;
+  for (const LidarPoint& p : a) {
+    const double range = std::hypot(p.x, p.y);
+    if (p.z <= -1.3f || range < 3.0 || range > 30.0 || std::abs(std::atan2(p.y, p.x)) > M_PI / 3) {
+      continue;
+    }
+    const Eigen::Vector3d q(p.x, p.y, p.z);
+    const auto [i, j, k] = key(p.x, p.y, p.z);
+    double best = kCell;
+    for (int di = -1; di <= 1; ++di) {
+      for (int dj = -1; dj <= 1; ++dj) {
+        for (int dk = -1; dk <= 1; ++dk) {
+          const auto cell = grid.find({i + di, j + dj, k + dk});
+          if (cell == grid.end()) continue;
+          for (const Eigen::Vector3d& r : cell->second) best = std::min(best, (r - q).norm());
+        }
+      }
+    }
+    if (best < kCell) sum += best, ++n;
+  }
+  return n > 0 ? sum / n : NAN;
+}
+
+LidarCloud transformed(const LidarCloud& cloud, const Eigen::Isometry3d& T) {
+  LidarCloud out = cloud;
+  for (LidarPoint& p : out) {
+    const Eigen::Vector3d q = T * Eigen::Vector3d(p.x, p.y, p.z);
+    p.x = static_cast<float>(q.x()), p.y = static_cast<float>(q.y()), p.z = static_cast<float>(q.z());
+  }
+  return out;
+}
+
+// The consecutive sweeps 15 .. 25 (1 m apart), each put into the next one's frame with the oxts
+// poses: deskewed to their oxts instants they overlap better than as measured, in all 10 pairs.
+TEST(KittiOxtsData, DeskewedConsecutiveSweepsAgreeBetter) {
+  LSF_REQUIRE_DATA(kDrive);
+  const std::string drive = test::dataPath(kDrive);
+  const auto stamps = kitti::readDriveStamps(drive);
+  const Eigen::Isometry3d T_velo_imu = kitti::readImuToVelo(kitti::calibrationDirOf(drive));
+  const auto samples = kitti::readOxtsDrive(drive);
+  const auto poses = kitti::posesRelativeToFirst(samples);
+  std::map<size_t, size_t> by_frame;  // frame number -> sample
+  for (size_t s = 0; s < samples.size(); ++s) by_frame[kitti::frameIndex(samples[s].name)] = s;
+  auto sweep = [&](size_t frame, bool deskew) {
+    const std::string name = samples[by_frame.at(frame)].name;
+    LidarCloud cloud = kitti::readVelodyneBin(drive + "/velodyne_points/data/" + name + ".bin");
+    if (deskew) {
+      const kitti::OxtsSample& s = samples[by_frame.at(frame)];
+      kitti::deskewSweep(cloud, stamps.clockOf(frame, name),
+                         kitti::transformTwist(kitti::imuTwist(s.packet), T_velo_imu), s.stamp);
+    }
+    return cloud;
+  };
+  double raw_sum = 0.0, deskewed_sum = 0.0;
+  int better = 0, pairs = 0;
+  for (size_t frame = 15; frame < 25; ++frame) {
+    const Eigen::Isometry3d next_from_this = T_velo_imu *
+                                             poses[by_frame.at(frame + 1)].inverse() *
+                                             poses[by_frame.at(frame)] * T_velo_imu.inverse();
+    const double raw =
+        meanNearestDistance(transformed(sweep(frame, false), next_from_this), sweep(frame + 1, false));
+    const double deskewed =
+        meanNearestDistance(transformed(sweep(frame, true), next_from_this), sweep(frame + 1, true));
+    raw_sum += raw, deskewed_sum += deskewed, ++pairs;
+    if (deskewed < raw) ++better;
+  }
+  std::cout << "mean nearest-point distance of consecutive sweeps (front 120 deg, above ground): "
+            << raw_sum / pairs << " m as measured, " << deskewed_sum / pairs << " m deskewed\n";
+  EXPECT_EQ(better, pairs);
+  EXPECT_LT(deskewed_sum, 0.98 * raw_sum);
 }
 
 }  // namespace

@@ -44,9 +44,11 @@ PhotometricShifts photometricShifts(const cv::Mat& left_bgr, const cv::Mat& righ
                                     const cv::Mat1f& sparse_disparity,
                                     const PhotometricCheckParams& params = {});
 
-/// Median |shift| [px] and the fraction with |shift| <= `within` [px] (0 when empty).
+/// Median shift, median |shift| [px] and the fraction with |shift| <= `within` [px] (0 when
+/// empty). The signed median tells a bias (the LiDAR nearer than the images say: > 0) from noise.
 struct ShiftSummary {
   int count = 0;
+  double median = 0.0;
   double median_abs = 0.0;
   double fraction_within = 0.0;
 };
