@@ -51,16 +51,13 @@ Options:
   --save-vis           also write <out>/vis/<frame>_{sparse,prior,confidence,disparity,depth,
                        error}.png, each with a colour bar in its unit (depth in metres,
                        disparity and error in px, confidence 0 .. 1)
-  --deskew             untwist each sweep before the fusion: per-point time from the azimuth
-                       (velodyne_points/timestamps_start.txt .. timestamps_end.txt), constant
-                       velocity from oxts/data/<frame>.txt turned into the Velodyne frame with
-                       calib_imu_to_velo.txt, every point moved to the image_02 instant. Off by
-                       default (the hold-out protocols score against rings of the same sweep).
-                       A frame without its packet or stamps is named and processed as measured.
-  --photometric-check  print, per frame and over all frames, the best sub-pixel shift delta in
-                       [-3, 3] px between image_02 at each LiDAR pixel (u, v, d) and image_03 at
-                       (u - d + delta, v) (5x5 grey ZNCC): median |delta| and the share with
-                       |delta| <= 0.5 px; with --deskew for the sweep as measured and deskewed
+  --deskew             untwist each sweep to its image_02 instant (point times from the azimuth
+                       and velodyne_points/timestamps_{start,end}.txt, constant velocity from
+                       oxts/data/<frame>.txt and calib_imu_to_velo.txt); a frame without its
+                       packet or stamps is named and processed as measured (doc/motion_kitti.md)
+  --photometric-check  per frame, the best shift delta in [-3, 3] px of image_03 at (u - d + delta,
+                       v) for image_02 at each LiDAR pixel (u, v, d): median delta, median |delta|,
+                       share of |delta| <= 0.5 px; with --deskew before and after
   --frames N           process only the first N frames
   --help               this text
 
@@ -89,8 +86,8 @@ struct Results {
   std::vector<lsf::DepthRow> rows;
   std::vector<lsf::DepthMetrics> scores;
   std::vector<lsf::FrameStats> stats;
-  std::vector<double> deskew_ms;         ///< [ms] per deskewed frame
-  std::vector<std::string> undeskewed;   ///< frames processed as measured despite --deskew
+  std::vector<double> deskew_ms;          ///< [ms] per deskewed frame
+  std::vector<std::string> undeskewed;    ///< frames processed as measured despite --deskew
   std::vector<lsf::ShiftRow> shift_rows;  ///< --photometric-check, per frame
   std::vector<double> shifts_before, shifts_after;  ///< all frames pooled
 };
@@ -315,8 +312,7 @@ void printChecks(const Options& o, const Results& results) {
     for (const lsf::FrameStats& s : results.stats) total += s.total_ms;
     std::cout << std::fixed << std::setprecision(1) << "Deskew: " << sum / results.deskew_ms.size()
               << " ms per frame (" << results.deskew_ms.size() << " frames); the pipeline: "
-              << (results.stats.empty() ? 0.0 : total / results.stats.size())
-              << " ms per frame\n";
+              << (results.stats.empty() ? 0.0 : total / results.stats.size()) << " ms per frame\n";
   }
 }
 
@@ -348,9 +344,7 @@ int run(const Options& o) {
             << (o.deskew ? ", sweeps deskewed" : "") << "\n";
   lsf::FusionPipeline pipeline(params);
   Results results;
-  std::vector<lsf::DepthRow>& rows = results.rows;
   const std::vector<lsf::DepthMetrics>& scores = results.scores;
-  const std::vector<lsf::FrameStats>& stats = results.stats;
   std::vector<std::string> failed;
   lsf::ProgressBar progress(std::cerr, static_cast<int>(frames.size()), ::isatty(2) != 0);
   for (size_t i = 0; i < frames.size(); ++i) {
@@ -370,15 +364,17 @@ int run(const Options& o) {
     throw std::runtime_error("no frame has a reference PNG in " + o.reference);
   }
   if (!scores.empty()) {
-    rows.push_back(
+    results.rows.push_back(
         {"mean (" + std::to_string(scores.size()) + " frames)", lsf::averageMetrics(scores)});
     std::cout << "Scores of " << lsf::methodName(params.method) << " against "
               << (o.holdout == "even" ? "the odd rings (hold-out)" : o.reference) << ":\n\n"
-              << lsf::formatDepthTable(rows) << "\n";
+              << lsf::formatDepthTable(results.rows) << "\n";
   }
-  if (!stats.empty()) std::cout << "Time per stage:\n\n" << lsf::formatTimingSummary(stats);
+  if (!results.stats.empty()) {
+    std::cout << "Time per stage:\n\n" << lsf::formatTimingSummary(results.stats);
+  }
   printChecks(o, results);
-  std::cout << "Wrote " << stats.size() << " depth PNGs to " << o.out << "\n";
+  std::cout << "Wrote " << results.stats.size() << " depth PNGs to " << o.out << "\n";
   if (!results.undeskewed.empty()) {
     std::string names;
     for (const auto& name : results.undeskewed) names += " " + name;

@@ -16,7 +16,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
-#include "kitti_key_value.h"
+
+#include "kitti_key_value.h"  // src/io internal
 
 namespace lidar_stereo_fusion {
 namespace kitti {

@@ -21,14 +21,14 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr size_t kOxtsValues = 30;
-constexpr size_t kOxtsReals = 25;             ///< then 5 integer status fields
+constexpr size_t kOxtsReals = 25;           ///< then 5 integer status fields
 constexpr double kEarthRadius = 6378137.0;  ///< [m] the devkit's er
 
 /// The names of oxts/dataformat.txt, in order (its third acceleration is misnamed "ay" there).
 constexpr std::array<const char*, kOxtsValues> kOxtsNames = {
-    "lat",   "lon",     "alt",     "roll",   "pitch",        "yaw",          "vn",      "ve",
-    "vf",    "vl",      "vu",      "ax",     "ay",           "az",           "af",      "al",
-    "au",    "wx",      "wy",      "wz",     "wf",           "wl",           "wu",      "pos_accuracy",
+    "lat",          "lon",     "alt",     "roll",    "pitch",   "yaw",    "vn", "ve",
+    "vf",           "vl",      "vu",      "ax",      "ay",      "az",     "af", "al",
+    "au",           "wx",      "wy",      "wz",      "wf",      "wl",     "wu", "pos_accuracy",
     "vel_accuracy", "navstat", "numsats", "posmode", "velmode", "orimode"};
 
 bool isBlank(const std::string& line) {
@@ -37,8 +37,8 @@ bool isBlank(const std::string& line) {
 
 /// The packet's fields in file order, for filling from 30 numbers.
 std::array<double*, kOxtsReals> realFields(OxtsPacket& p) {
-  return {&p.lat, &p.lon, &p.alt, &p.roll, &p.pitch, &p.yaw, &p.vn, &p.ve, &p.vf,
-          &p.vl,  &p.vu,  &p.ax,  &p.ay,   &p.az,    &p.af,  &p.al, &p.au, &p.wx,
+  return {&p.lat, &p.lon, &p.alt, &p.roll, &p.pitch, &p.yaw,          &p.vn,          &p.ve, &p.vf,
+          &p.vl,  &p.vu,  &p.ax,  &p.ay,   &p.az,    &p.af,           &p.al,          &p.au, &p.wx,
           &p.wy,  &p.wz,  &p.wf,  &p.wl,   &p.wu,    &p.pos_accuracy, &p.vel_accuracy};
 }
 

@@ -53,8 +53,8 @@ SweepClock DriveStamps::clockOf(size_t index, const std::string& name) const {
   const double stamp = stampAt(sweep, index);
   if (!std::isfinite(stamp)) {
     throw std::runtime_error("frame " + name + " has no Velodyne timestamp (" +
-                             (sweep_is_end ? "timestamps_end.txt" : "timestamps.txt") +
-                             " line " + std::to_string(index + 1) + " is blank or missing)");
+                             (sweep_is_end ? "timestamps_end.txt" : "timestamps.txt") + " line " +
+                             std::to_string(index + 1) + " is blank or missing)");
   }
   return sweepClock(stamp, stampAt(sweep_start, index), sweep_is_end);
 }
@@ -89,8 +89,8 @@ DriveStamps readDriveStamps(const std::string& drive_dir) {
 void deskewSweep(LidarCloud& cloud, const SweepClock& clock, const Twist& velodyne_twist,
                  double target_stamp, int samples) {
   if (!velodyne_twist.linear.allFinite() || !velodyne_twist.angular.allFinite() ||
-      !std::isfinite(target_stamp) || !std::isfinite(clock.stamp) ||
-      !std::isfinite(clock.period) || !std::isfinite(clock.stamp_after_start)) {
+      !std::isfinite(target_stamp) || !std::isfinite(clock.stamp) || !std::isfinite(clock.period) ||
+      !std::isfinite(clock.stamp_after_start)) {
     throw std::invalid_argument("deskewSweep: a velocity, stamp or period is not finite");
   }
   setPointTimesFromAzimuth(cloud, clock);

@@ -51,7 +51,8 @@ double median(std::vector<double> values) {
   const size_t mid = values.size() / 2;
   std::nth_element(values.begin(), values.begin() + mid, values.end());
   double m = values[mid];
-  if (values.size() % 2 == 0) m = 0.5 * (m + *std::max_element(values.begin(), values.begin() + mid));
+  if (values.size() % 2 == 0)
+    m = 0.5 * (m + *std::max_element(values.begin(), values.begin() + mid));
   return m;
 }
 

@@ -22,7 +22,8 @@ std::vector<geometry_msgs::TransformStamped> kittiEgoMotionTf(
   const std::vector<Eigen::Isometry3d> poses = kitti::posesRelativeToFirst(samples);
   std::vector<geometry_msgs::TransformStamped> transforms;
   for (size_t i = 0; i < poses.size(); ++i) {
-    transforms.push_back(transformMsg(poses[i], fixed_frame, imu_frame, ros::Time(samples[i].stamp)));
+    transforms.push_back(
+        transformMsg(poses[i], fixed_frame, imu_frame, ros::Time(samples[i].stamp)));
   }
   return transforms;
 }

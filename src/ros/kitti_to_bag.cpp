@@ -382,8 +382,8 @@ lsf::KittiEgoMotion readEgoMotion(const Options& options, const std::vector<Fram
     lo = std::min({lo, f.image_stamp.toSec(), f.cloud_stamp.toSec() - f.sweep.stamp_after_start});
     hi = std::max({hi, f.image_stamp.toSec(), f.cloud_stamp.toSec()});
   }
-  return lsf::readKittiEgoMotion(options.calib_dir, options.drive_dir, options.period > 0.0, lo,
-                                 hi, std::cerr);
+  return lsf::readKittiEgoMotion(options.calib_dir, options.drive_dir, options.period > 0.0, lo, hi,
+                                 std::cerr);
 }
 
 void removePartial(const Options& options) {

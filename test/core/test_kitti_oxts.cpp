@@ -222,11 +222,11 @@ TEST(KittiSweep, AzimuthTimeRunsClockwiseFromTheRear) {
   EXPECT_NEAR(clock.period, 0.1, 1e-12);
   EXPECT_NEAR(clock.stamp_after_start, 0.1, 1e-12);
   const double period = clock.period;
-  EXPECT_NEAR(kitti::azimuthTime(-1.0, 1e-300, clock), -period, 1e-12);  // rear, start
-  EXPECT_NEAR(kitti::azimuthTime(0.0, 1.0, clock), -0.75 * period, 1e-12);  // left
-  EXPECT_NEAR(kitti::azimuthTime(1.0, 0.0, clock), -0.5 * period, 1e-12);   // front
+  EXPECT_NEAR(kitti::azimuthTime(-1.0, 1e-300, clock), -period, 1e-12);      // rear, start
+  EXPECT_NEAR(kitti::azimuthTime(0.0, 1.0, clock), -0.75 * period, 1e-12);   // left
+  EXPECT_NEAR(kitti::azimuthTime(1.0, 0.0, clock), -0.5 * period, 1e-12);    // front
   EXPECT_NEAR(kitti::azimuthTime(0.0, -1.0, clock), -0.25 * period, 1e-12);  // right
-  EXPECT_NEAR(kitti::azimuthTime(-1.0, -1e-300, clock), 0.0, 1e-12);        // rear, end
+  EXPECT_NEAR(kitti::azimuthTime(-1.0, -1e-300, clock), 0.0, 1e-12);         // rear, end
   // Stamped at the forward instant (no timestamps_end.txt): front = 0, 0.1 s sweep.
   const kitti::SweepClock forward = kitti::sweepClock(100.05, NAN, false);
   EXPECT_EQ(forward.period, 0.1);

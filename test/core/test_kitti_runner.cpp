@@ -329,12 +329,14 @@ double meanDifference(const cv::Mat1f& a, const cv::Mat1f& b, int first, int las
 // --deskew: a standing rig changes nothing; at 10 m/s the sphere's left side (seen before the
 // forward instant) comes nearer, its right side goes farther: a point az to the side, seen
 // az / 360 * 0.1 s from the front, moves by delta = 10 m/s times that along x, and the sphere
-// along a pixel's ray by delta cos^2(az) (8.2 cm and 6.2 cm at 29.5 deg, the image's edges); a frame without its packet is named, processed as
-// measured and makes the exit status 1; a missing calib_imu_to_velo.txt fails the run.
+// along a pixel's ray by delta cos^2(az) (8.2 cm and 6.2 cm at 29.5 deg, the image's edges); a
+// frame without its packet is named, processed as measured and makes the exit status 1; a missing
+// calib_imu_to_velo.txt fails the run.
 TEST(KittiRunner, DeskewMovesTheSweepToTheImageInstant) {
   REQUIRE_RUNNER();
   SyntheticDrive drive;
-  const std::string raw = drive.outDir().string() + "/raw", still = drive.outDir().string() + "/still";
+  const std::string raw = drive.outDir().string() + "/raw",
+                    still = drive.outDir().string() + "/still";
   ASSERT_EQ(drive.run("--out " + raw + " --method lidar_bi").status, 0);
   drive.writeEgoMotion(0.0);
   RunResult r = drive.run("--out " + still + " --method lidar_bi --deskew --photometric-check");

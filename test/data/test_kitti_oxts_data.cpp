@@ -55,9 +55,10 @@ TEST(KittiOxtsData, DevkitPosesAdvanceByTheVelocity) {
     SCOPED_TRACE(samples[i].name);
     const Eigen::Isometry3d relative = poses[i].inverse() * poses[i + 1];
     // The mean of the two packets' velocities (in packet i's frame) times the time between them.
-    const Eigen::Vector3d expected = 0.5 * dt *
-                                     (kitti::imuTwist(samples[i].packet).linear +
-                                      relative.linear() * kitti::imuTwist(samples[i + 1].packet).linear);
+    const Eigen::Vector3d expected =
+        0.5 * dt *
+        (kitti::imuTwist(samples[i].packet).linear +
+         relative.linear() * kitti::imuTwist(samples[i + 1].packet).linear);
     // Of a ~1.1 m step: the GPS/INS positions and velocities agree within 3 to 6 cm here; a
     // wrong axis, sign or heading convention is off by metres.
     EXPECT_NEAR((relative.translation() - expected).norm(), 0.0, 0.08)
@@ -78,9 +79,8 @@ TEST(KittiOxtsData, DeskewMovesTheRearByASweepsTravelAndTheFrontByTheImageOffset
   const double speed =
       kitti::imuTwist(kitti::readOxtsPacket(drive + "/oxts/data/0000000020.txt")).linear.norm();
   const kitti::SweepClock clock = stamps.clockOf(20, "0000000020");
-  const double image_after_front =
-      stamps.imageStamp(20, "0000000020") - (clock.stamp - clock.stamp_after_start +
-                                             0.5 * clock.period);
+  const double image_after_front = stamps.imageStamp(20, "0000000020") -
+                                   (clock.stamp - clock.stamp_after_start + 0.5 * clock.period);
   double front = 0.0, rear = 0.0;
   int n_front = 0, n_rear = 0;
   for (size_t k = 0; k < raw.size(); ++k) {
@@ -137,7 +137,8 @@ LidarCloud transformed(const LidarCloud& cloud, const Eigen::Isometry3d& T) {
   LidarCloud out = cloud;
   for (LidarPoint& p : out) {
     const Eigen::Vector3d q = T * Eigen::Vector3d(p.x, p.y, p.z);
-    p.x = static_cast<float>(q.x()), p.y = static_cast<float>(q.y()), p.z = static_cast<float>(q.z());
+    p.x = static_cast<float>(q.x()), p.y = static_cast<float>(q.y()),
+    p.z = static_cast<float>(q.z());
   }
   return out;
 }
@@ -166,13 +167,12 @@ TEST(KittiOxtsData, DeskewedConsecutiveSweepsAgreeBetter) {
   double raw_sum = 0.0, deskewed_sum = 0.0;
   int better = 0, pairs = 0;
   for (size_t frame = 15; frame < 25; ++frame) {
-    const Eigen::Isometry3d next_from_this = T_velo_imu *
-                                             poses[by_frame.at(frame + 1)].inverse() *
+    const Eigen::Isometry3d next_from_this = T_velo_imu * poses[by_frame.at(frame + 1)].inverse() *
                                              poses[by_frame.at(frame)] * T_velo_imu.inverse();
-    const double raw =
-        meanNearestDistance(transformed(sweep(frame, false), next_from_this), sweep(frame + 1, false));
-    const double deskewed =
-        meanNearestDistance(transformed(sweep(frame, true), next_from_this), sweep(frame + 1, true));
+    const double raw = meanNearestDistance(transformed(sweep(frame, false), next_from_this),
+                                           sweep(frame + 1, false));
+    const double deskewed = meanNearestDistance(transformed(sweep(frame, true), next_from_this),
+                                                sweep(frame + 1, true));
     raw_sum += raw, deskewed_sum += deskewed, ++pairs;
     if (deskewed < raw) ++better;
   }

@@ -36,9 +36,9 @@ struct OxtsPacket {
 
 /// Reads one packet file: one line of exactly 30 numbers (25 finite reals, then 5 integers),
 /// separated by blanks; blank lines after it are allowed. Throws std::runtime_error naming the
-/// file, the line and the value (by its dataformat.txt name) when the file is missing or unreadable,
-/// has no packet, another count of values, a value that is not a finite number (or not an integer
-/// for the status fields), or a second packet line.
+/// file, the line and the value (by its dataformat.txt name) when the file is missing or
+/// unreadable, has no packet, another count of values, a value that is not a finite number (or not
+/// an integer for the status fields), or a second packet line.
 OxtsPacket readOxtsPacket(const std::string& path);
 
 /// calib_imu_to_velo.txt in `dir` (keys R, T): T_velo_imu, which maps IMU coordinates into

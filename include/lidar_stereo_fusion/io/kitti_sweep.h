@@ -18,9 +18,9 @@ namespace kitti {
 
 /// The clock of one sweep.
 struct SweepClock {
-  double stamp = 0.0;               ///< [s] since the epoch: the cloud's stamp
-  double period = 0.1;              ///< [s] from the sweep's start to its end
-  double stamp_after_start = 0.1;   ///< [s] from the sweep's start to `stamp`
+  double stamp = 0.0;              ///< [s] since the epoch: the cloud's stamp
+  double period = 0.1;             ///< [s] from the sweep's start to its end
+  double stamp_after_start = 0.1;  ///< [s] from the sweep's start to `stamp`
 };
 
 /// The clock of a sweep stamped at `stamp` [s]: at its end (stamp_is_end, from

@@ -14,9 +14,9 @@
 namespace lidar_stereo_fusion {
 
 struct PhotometricCheckParams {
-  int patch_radius = 2;      ///< [px] patch of (2 r + 1)^2 pixels (5x5)
-  double max_shift = 3.0;    ///< [px] deltas searched in [-max_shift, max_shift]
-  double step = 0.25;        ///< [px] search step; the best step is refined by a parabola
+  int patch_radius = 2;        ///< [px] patch of (2 r + 1)^2 pixels (5x5)
+  double max_shift = 3.0;      ///< [px] deltas searched in [-max_shift, max_shift]
+  double step = 0.25;          ///< [px] search step; the best step is refined by a parabola
   double min_patch_std = 2.0;  ///< [grey levels] flatter left patches are not scored (no texture)
   /// Throws std::invalid_argument for r < 1, step <= 0, max_shift < step, min_patch_std < 0.
   void validate() const;

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include <Eigen/Geometry>
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/time.h>
+#include <Eigen/Geometry>
 
 #include "lidar_stereo_fusion/io/kitti_oxts.h"
 
