@@ -14,10 +14,10 @@
 //   /tf_static                       velodyne -> left_camera_optical_frame (T_cam_velo^-1) and
 //                                    left -> right optical frame (+B along x); latched on replay;
 //                                    with calib_imu_to_velo.txt also imu_link -> velodyne
-//   /tf                              odom -> imu_link at every oxts/timestamps.txt stamp of the
-//                                    packets in oxts/data: the oxts ego-motion (the devkit's
-//                                    Mercator poses relative to the first packet); not with
-//                                    --period, whose stamps are not the drive's
+//   /tf                              odom -> imu_link at the oxts/timestamps.txt stamps of the
+//                                    oxts/data packets bracketing the frames: the ego-motion (the
+//                                    devkit's Mercator poses relative to the first of them); not
+//                                    with --period, whose stamps are not the drive's
 //
 // Stamps come from the KITTI timestamp files. Both images of a pair (and both camera infos) take
 // the image_02 stamp: the pair is hardware-triggered and rectified together, the image_03 stamps
@@ -325,6 +325,7 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
   // tf2's static buffer; a first message time keeps `rosbag play` from waiting).
   ros::Time first = frames.front().image_stamp;
   for (const auto& f : frames) first = std::min({first, f.image_stamp, f.cloud_stamp});
+  if (!ego.samples.empty()) first = std::min(first, ros::Time(ego.samples.front().stamp));
   tf2_msgs::TFMessage tf_static;
   tf_static.transforms.push_back(
       lsf::kittiVelodyneToCamera(calib, kVelodyneFrame, kLeftFrame, first));
