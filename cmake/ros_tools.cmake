@@ -5,8 +5,10 @@
 #   kitti_calibration_publisher     static TF velodyne -> left -> right camera from KITTI calib
 #   kitti_to_bag                    KITTI raw drive -> ROS 1 bag with the rig's topics
 
-# ROS messages built from the ROS-free calibration readers; shared by the tools and their tests.
-add_library(${PROJECT_NAME}_calibration_msgs STATIC src/ros/calibration_msgs.cpp)
+# ROS messages built from the ROS-free calibration readers (and the KITTI oxts ego-motion as TF);
+# shared by the tools and their tests.
+add_library(${PROJECT_NAME}_calibration_msgs STATIC src/ros/calibration_msgs.cpp
+  src/ros/kitti_ego_motion.cpp)
 target_include_directories(${PROJECT_NAME}_calibration_msgs SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
 target_link_libraries(${PROJECT_NAME}_calibration_msgs PUBLIC
   ${PROJECT_NAME}_io ${catkin_LIBRARIES})

@@ -6,7 +6,9 @@
 #include <cstdio>
 #include <cstring>
 
+#include <chrono>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -19,7 +21,9 @@
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/holdout.h"
 #include "lidar_stereo_fusion/io/kitti.h"
+#include "lidar_stereo_fusion/io/kitti_sweep.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
+#include "lidar_stereo_fusion/io/photometric_check.h"
 #include "lidar_stereo_fusion/io/report.h"
 #include "lidar_stereo_fusion/io/visualization.h"
 
@@ -47,28 +51,52 @@ Options:
   --save-vis           also write <out>/vis/<frame>_{sparse,prior,confidence,disparity,depth,
                        error}.png, each with a colour bar in its unit (depth in metres,
                        disparity and error in px, confidence 0 .. 1)
+  --deskew             untwist each sweep to its image_02 instant (point times from the azimuth
+                       and velodyne_points/timestamps_{start,end}.txt, constant velocity from
+                       oxts/data/<frame>.txt and calib_imu_to_velo.txt); a frame without its
+                       packet or stamps is named and processed as measured (doc/motion_kitti.md)
+  --photometric-check  per frame, the best shift delta in [-3, 3] px of image_03 at (u - d + delta,
+                       v) for image_02 at each LiDAR pixel (u, v, d): median delta, median |delta|,
+                       share of |delta| <= 0.5 px; with --deskew before and after
   --frames N           process only the first N frames
   --help               this text
 
 Frames with image_02 but without image_03 or the .bin are named and skipped; a frame that fails
 (corrupt .bin or image, ...) is named and the run goes on with the next one.
 
-Exit status: 0 on success, 1 when any frame failed or on missing or corrupt input (calibration,
+Exit status: 0 on success, 1 when any frame failed (or, with --deskew, was not deskewed) or on missing or corrupt input (calibration,
 drive, parameters, unwritable output folder), 2 on a bad command line.
 )";
 
 struct Options {
   std::string drive, out, params, reference, holdout = "none";
   std::optional<std::string> method;
-  bool save_vis = false;
+  bool save_vis = false, deskew = false, photometric_check = false;
   int frames = 0;  // 0 = all
+};
+
+/// What --deskew needs for every frame (read once).
+struct Deskew {
+  lsf::kitti::DriveStamps stamps;
+  Eigen::Isometry3d T_velo_imu = Eigen::Isometry3d::Identity();
+};
+
+/// What the frames give.
+struct Results {
+  std::vector<lsf::DepthRow> rows;
+  std::vector<lsf::DepthMetrics> scores;
+  std::vector<lsf::FrameStats> stats;
+  std::vector<double> deskew_ms;          ///< [ms] per deskewed frame
+  std::vector<std::string> undeskewed;    ///< frames processed as measured despite --deskew
+  std::vector<lsf::ShiftRow> shift_rows;  ///< --photometric-check, per frame
+  std::vector<double> shifts_before, shifts_after;  ///< all frames pooled
 };
 
 Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(
       argc, argv,
       {"--kitti-raw", "--out", "--method", "--params", "--reference", "--frames", "--holdout"},
-      {"--save-vis", "--help"});
+      {"--save-vis", "--deskew", "--photometric-check", "--help"});
   Options o;
   if (cl.has("--help")) return o;
   o.drive = cl.value("--kitti-raw");
@@ -85,6 +113,8 @@ Options parseOptions(int argc, char** argv) {
     throw lsf::UsageError("--holdout even and --reference exclude each other");
   }
   o.save_vis = cl.has("--save-vis");
+  o.deskew = cl.has("--deskew");
+  o.photometric_check = cl.has("--photometric-check");
   o.frames = cl.intValue("--frames", 0, 1, 1000000);
   return o;
 }
@@ -170,22 +200,72 @@ void requireWritable(const fs::path& dir) {
   fs::remove(probe);
 }
 
+/// What every frame needs.
+struct Context {
+  const Options& options;
+  lsf::kitti::Calibration calib;
+  lsf::FusionParams params;
+  std::optional<Deskew> deskew;  ///< with --deskew
+};
+
+/// --photometric-check: the shifts of the sweep's LiDAR pixels in the left image.
+lsf::PhotometricShifts shiftsOf(const Context& c, const lsf::kitti::FrameData& data,
+                                const lsf::LidarCloud& cloud) {
+  const lsf::SparseDisparity sparse =
+      lsf::projectCloud(cloud, c.calib.T_cam_velo, c.calib.camera, c.params.projection);
+  return lsf::photometricShifts(data.left, data.right, sparse.disparity);
+}
+
+/// --deskew: untwists the sweep and times it; a frame that cannot be deskewed (no packet or
+/// stamp) is named and counted, and goes on as measured. True when deskewed.
+bool deskewSweep(const Context& c, const std::string& name, lsf::LidarCloud& cloud,
+                 Results& results) {
+  try {
+    const auto start = std::chrono::steady_clock::now();
+    lsf::kitti::deskewFrame(c.options.drive, name, c.deskew->stamps, c.deskew->T_velo_imu, cloud);
+    results.deskew_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
+    return true;
+  } catch (const std::runtime_error& e) {
+    std::cerr << "\nkitti_runner: warning: frame " << name
+              << " is not deskewed, processed as measured: " << e.what() << "\n";
+    results.undeskewed.push_back(name);
+    return false;
+  }
+}
+
 /// Runs one frame and writes its outputs; throws std::runtime_error naming the problem.
-void runFrame(const Options& o, const lsf::kitti::Frame& frame,
-              const lsf::kitti::Calibration& calib, const lsf::FusionParams& params,
-              lsf::FusionPipeline& pipeline, std::vector<lsf::DepthRow>& rows,
-              std::vector<lsf::DepthMetrics>& scores, std::vector<lsf::FrameStats>& stats) {
+void runFrame(const Context& c, const lsf::kitti::Frame& frame, lsf::FusionPipeline& pipeline,
+              Results& results) {
+  const Options& o = c.options;
+  const lsf::kitti::Calibration& calib = c.calib;
   lsf::kitti::FrameData data = lsf::kitti::loadFrame(frame, calib.camera);
   if (!data.rings.plausible) {
     std::cerr << "\nkitti_runner: warning: frame " << frame.name << ": rings of " << frame.velodyne
               << " are implausible (" << data.rings.fallbacks << "); using "
               << lsf::ringSourceName(data.rings.source) << " (" << data.rings.rings << " rings)\n";
   }
+  std::optional<lsf::PhotometricShifts> before;
+  if (o.photometric_check) before = shiftsOf(c, data, data.cloud);
+  const bool deskewed = c.deskew && deskewSweep(c, frame.name, data.cloud, results);
+  if (before) {
+    lsf::ShiftRow row{frame.name, lsf::summarizeShifts(before->shifts), std::nullopt};
+    results.shifts_before.insert(results.shifts_before.end(), before->shifts.begin(),
+                                 before->shifts.end());
+    if (deskewed) {
+      const lsf::PhotometricShifts after = shiftsOf(c, data, data.cloud);
+      row.after = lsf::summarizeShifts(after.shifts);
+      results.shifts_after.insert(results.shifts_after.end(), after.shifts.begin(),
+                                  after.shifts.end());
+    }
+    results.shift_rows.push_back(row);
+  }
   lsf::FusionInput input{data.left, data.right, {}, calib.T_cam_velo, calib.camera};
   std::optional<cv::Mat1f> reference;
   if (o.holdout == "even") {
     lsf::HoldoutCase holdout =
-        lsf::makeRingHoldout(data.cloud, calib.T_cam_velo, calib.camera, params.projection);
+        lsf::makeRingHoldout(data.cloud, calib.T_cam_velo, calib.camera, c.params.projection);
     input.cloud = std::move(holdout.fed);
     reference = holdout.reference_depth;
   } else {
@@ -204,14 +284,36 @@ void runFrame(const Options& o, const lsf::kitti::Frame& frame,
   }
   lsf::kitti::writeDepthPng((fs::path(o.out) / (frame.name + ".png")).string(), result.depth);
   if (reference) {
-    scores.push_back(lsf::evaluateDepth(result.depth, *reference, calib.camera));
-    rows.push_back({frame.name, scores.back()});
+    results.scores.push_back(lsf::evaluateDepth(result.depth, *reference, calib.camera));
+    results.rows.push_back({frame.name, results.scores.back()});
   }
   if (o.save_vis) {
     saveVisualisation(fs::path(o.out) / "vis", frame.name, data.left, result, reference,
                       calib.camera);
   }
-  stats.push_back(result.stats);
+  results.stats.push_back(result.stats);
+}
+
+/// The tables of --photometric-check and the time --deskew took.
+void printChecks(const Options& o, const Results& results) {
+  if (o.photometric_check && !results.shift_rows.empty()) {
+    std::vector<lsf::ShiftRow> rows = results.shift_rows;
+    lsf::ShiftRow all{"all (" + std::to_string(rows.size()) + " frames)",
+                      lsf::summarizeShifts(results.shifts_before), std::nullopt};
+    if (!results.shifts_after.empty()) all.after = lsf::summarizeShifts(results.shifts_after);
+    rows.push_back(all);
+    std::cout << "Photometric check (best shift delta of image_03 at u - d + delta, 5x5 ZNCC):\n\n"
+              << lsf::formatShiftTable(rows) << "\n";
+  }
+  if (!results.deskew_ms.empty()) {
+    double sum = 0.0;
+    for (const double ms : results.deskew_ms) sum += ms;
+    double total = 0.0;
+    for (const lsf::FrameStats& s : results.stats) total += s.total_ms;
+    std::cout << std::fixed << std::setprecision(1) << "Deskew: " << sum / results.deskew_ms.size()
+              << " ms per frame (" << results.deskew_ms.size() << " frames); the pipeline: "
+              << (results.stats.empty() ? 0.0 : total / results.stats.size()) << " ms per frame\n";
+  }
 }
 
 int run(const Options& o) {
@@ -219,8 +321,11 @@ int run(const Options& o) {
   // The drive first: a wrong --kitti-raw must be named as such, not as a missing calibration.
   std::vector<std::string> incomplete;
   std::vector<lsf::kitti::Frame> frames = lsf::kitti::listFrames(o.drive, &incomplete);
-  const lsf::kitti::Calibration calib =
-      lsf::kitti::readCalibration(lsf::kitti::calibrationDirOf(o.drive));
+  Context c{o, lsf::kitti::readCalibration(lsf::kitti::calibrationDirOf(o.drive)), params, {}};
+  if (o.deskew) {  // missing drive-wide inputs fail the run; a frame's missing packet does not
+    c.deskew = Deskew{lsf::kitti::readDriveStamps(o.drive),
+                      lsf::kitti::readImuToVelo(lsf::kitti::calibrationDirOf(o.drive))};
+  }
   for (const std::string& line : incomplete) {
     std::cerr << "kitti_runner: warning: skipped " << line << "\n";
   }
@@ -235,17 +340,17 @@ int run(const Options& o) {
 
   std::cerr << "kitti_runner: " << frames.size() << " frames, method "
             << lsf::methodName(params.method)
-            << (o.holdout == "even" ? ", hold-out: even rings in, odd rings scored" : "") << "\n";
+            << (o.holdout == "even" ? ", hold-out: even rings in, odd rings scored" : "")
+            << (o.deskew ? ", sweeps deskewed" : "") << "\n";
   lsf::FusionPipeline pipeline(params);
-  std::vector<lsf::DepthRow> rows;
-  std::vector<lsf::DepthMetrics> scores;
-  std::vector<lsf::FrameStats> stats;
+  Results results;
+  const std::vector<lsf::DepthMetrics>& scores = results.scores;
   std::vector<std::string> failed;
   lsf::ProgressBar progress(std::cerr, static_cast<int>(frames.size()), ::isatty(2) != 0);
   for (size_t i = 0; i < frames.size(); ++i) {
     progress.update(static_cast<int>(i), frames[i].name);
     try {
-      runFrame(o, frames[i], calib, params, pipeline, rows, scores, stats);
+      runFrame(c, frames[i], pipeline, results);
     } catch (const std::exception& e) {  // name it and go on with the next frame
       failed.push_back(frames[i].name);
       std::cerr << "\nkitti_runner: error: frame " << frames[i].name << " failed: " << e.what()
@@ -259,14 +364,23 @@ int run(const Options& o) {
     throw std::runtime_error("no frame has a reference PNG in " + o.reference);
   }
   if (!scores.empty()) {
-    rows.push_back(
+    results.rows.push_back(
         {"mean (" + std::to_string(scores.size()) + " frames)", lsf::averageMetrics(scores)});
     std::cout << "Scores of " << lsf::methodName(params.method) << " against "
               << (o.holdout == "even" ? "the odd rings (hold-out)" : o.reference) << ":\n\n"
-              << lsf::formatDepthTable(rows) << "\n";
+              << lsf::formatDepthTable(results.rows) << "\n";
   }
-  if (!stats.empty()) std::cout << "Time per stage:\n\n" << lsf::formatTimingSummary(stats);
-  std::cout << "Wrote " << stats.size() << " depth PNGs to " << o.out << "\n";
+  if (!results.stats.empty()) {
+    std::cout << "Time per stage:\n\n" << lsf::formatTimingSummary(results.stats);
+  }
+  printChecks(o, results);
+  std::cout << "Wrote " << results.stats.size() << " depth PNGs to " << o.out << "\n";
+  if (!results.undeskewed.empty()) {
+    std::string names;
+    for (const auto& name : results.undeskewed) names += " " + name;
+    std::cerr << "kitti_runner: " << results.undeskewed.size() << " of " << frames.size()
+              << " frames not deskewed (processed as measured):" << names << "\n";
+  }
   if (!failed.empty() || !incomplete.empty()) {
     std::string names;
     for (const auto& name : failed) names += " " + name;
@@ -274,7 +388,7 @@ int run(const Options& o) {
               << (failed.empty() ? "" : ":" + names) << "; " << incomplete.size()
               << " incomplete frames skipped\n";
   }
-  return failed.empty() ? 0 : 1;
+  return failed.empty() && results.undeskewed.empty() ? 0 : 1;
 }
 
 }  // namespace

@@ -12,7 +12,12 @@
 //   /velodyne_points                 sensor_msgs/PointCloud2, frame velodyne: x, y, z, intensity
 //                                    float32 [m, m, m, reflectance], ring uint16, time float32 [s]
 //   /tf_static                       velodyne -> left_camera_optical_frame (T_cam_velo^-1) and
-//                                    left -> right optical frame (+B along x); latched on replay
+//                                    left -> right optical frame (+B along x); latched on replay;
+//                                    with calib_imu_to_velo.txt also imu_link -> velodyne
+//   /tf                              odom -> imu_link at the oxts/timestamps.txt stamps of the
+//                                    oxts/data packets bracketing the frames: the ego-motion (the
+//                                    devkit's Mercator poses relative to the first of them); not
+//                                    with --period, whose stamps are not the drive's
 //
 // Stamps come from the KITTI timestamp files. Both images of a pair (and both camera infos) take
 // the image_02 stamp: the pair is hardware-triggered and rectified together, the image_03 stamps
@@ -20,10 +25,9 @@
 // end of its sweep (velodyne_points/timestamps_end.txt), as velodyne_driver stamps a scan at its
 // last packet: about 40 ms after the images here (near, not equal). Without timestamps_end.txt
 // it takes timestamps.txt, the instant the scanner faced forward and triggered the cameras.
-// Per-point `time` is the offset [s] from the cloud stamp, from the point's azimuth: the HDL-64E
-// spins clockwise seen from above and a KITTI sweep runs from the rear (timestamps_start.txt)
-// through the front (timestamps.txt) to the rear again (timestamps_end.txt), so
-// time = (pi - atan2(y, x)) / (2 pi) * (end - start) - (stamp - start), in [-(end - start), 0].
+// Per-point `time` is the offset [s] from the cloud stamp, from the point's azimuth
+// (kitti::azimuthTime: the sweep runs clockwise from the rear at timestamps_start.txt through the
+// front to the rear at timestamps_end.txt), in [-(end - start), 0].
 // Rings are recovered from the sweep storage order (recoverRingsBySweepOrder).
 //
 // --period S restamps the frames as a stream at a fixed period: frame k's images at the first
@@ -40,6 +44,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -58,8 +63,10 @@
 
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
+#include "lidar_stereo_fusion/io/kitti_sweep.h"
 #include "lidar_stereo_fusion/ros/calibration_msgs.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
+#include "lidar_stereo_fusion/ros/kitti_ego_motion.h"
 
 namespace lsf = lidar_stereo_fusion;
 namespace fs = std::filesystem;
@@ -75,7 +82,9 @@ constexpr char kRightImageTopic[] = "/stereo/right/image_rect_color";
 constexpr char kRightInfoTopic[] = "/stereo/right/camera_info";
 constexpr char kCloudTopic[] = "/velodyne_points";
 constexpr char kTfStaticTopic[] = "/tf_static";
-constexpr double kDefaultSweepPeriod = 0.1;  ///< HDL-64E at 10 Hz [s], when start/end are absent
+constexpr char kTfTopic[] = "/tf";
+constexpr char kImuFrame[] = "imu_link";
+constexpr char kFixedFrame[] = "odom";
 constexpr size_t kHdl64Rings = 64;
 
 struct Options {
@@ -166,19 +175,8 @@ std::string joined(const std::vector<std::string>& names) {
 struct FrameToWrite {
   lsf::kitti::Frame files;
   ros::Time image_stamp, cloud_stamp;
-  double sweep_period = kDefaultSweepPeriod;       ///< [s] timestamps_end - timestamps_start
-  double stamp_after_start = kDefaultSweepPeriod;  ///< [s] from the sweep start to cloud_stamp
+  lsf::kitti::SweepClock sweep;  ///< its period and stamp_after_start give the point times
 };
-
-/// Sets each point's time [s] relative to the cloud stamp from its azimuth.
-void setPointTimes(const FrameToWrite& frame, lsf::LidarCloud& cloud) {
-  for (lsf::LidarPoint& p : cloud) {
-    const double azimuth = std::atan2(static_cast<double>(p.y), static_cast<double>(p.x));
-    // Clockwise from the rear (azimuth +pi) at the sweep start to the rear again (-pi) at its end.
-    const double since_start = (M_PI - azimuth) / (2.0 * M_PI) * frame.sweep_period;
-    p.time = static_cast<float>(since_start - frame.stamp_after_start);
-  }
-}
 
 /// Reads a frame (images checked against the calibration's size, rings recovered by sweep order).
 lsf::kitti::FrameData loadFrame(const FrameToWrite& frame, const lsf::StereoCamera& camera) {
@@ -192,7 +190,7 @@ lsf::kitti::FrameData loadFrame(const FrameToWrite& frame, const lsf::StereoCame
     std::cerr << "kitti_to_bag: warning: frame " << frame.files.name << ": recovered "
               << rings.size() << " rings, an HDL-64E sweep has " << kHdl64Rings << "\n";
   }
-  setPointTimes(frame, data.cloud);
+  lsf::kitti::setPointTimesFromAzimuth(data.cloud, frame.sweep);
   return data;
 }
 
@@ -256,15 +254,7 @@ std::vector<FrameToWrite> selectFrames(const Options& options) {
   std::vector<std::string> unstamped;
   for (const auto& files : complete) {
     if (options.max_frames > 0 && static_cast<int>(frames.size()) >= options.max_frames) break;
-    size_t index = 0;
-    try {
-      size_t used = 0;
-      index = std::stoul(files.name, &used);
-      if (used != files.name.size()) throw std::invalid_argument(files.name);
-    } catch (const std::exception&) {
-      throw std::runtime_error("KITTI: frame file name " + files.name +
-                               " is not a frame number (expected e.g. 0000000005)");
-    }
+    const size_t index = lsf::kitti::frameIndex(files.name);
     const auto image_stamp = stampOf(image_stamps, index);
     const auto sweep_stamp = stampOf(sweep_stamps, index);
     if (!image_stamp || !sweep_stamp) {
@@ -275,11 +265,9 @@ std::vector<FrameToWrite> selectFrames(const Options& options) {
     frame.files = files;
     frame.image_stamp = ros::Time(*image_stamp);
     frame.cloud_stamp = ros::Time(*sweep_stamp);
-    const auto start = stampOf(starts, index);
-    if (have_end && start && *sweep_stamp > *start && *sweep_stamp - *start < 1.0) {
-      frame.sweep_period = *sweep_stamp - *start;
-    }
-    frame.stamp_after_start = have_end ? frame.sweep_period : 0.5 * frame.sweep_period;
+    frame.sweep = lsf::kitti::sweepClock(
+        *sweep_stamp, stampOf(starts, index).value_or(std::numeric_limits<double>::quiet_NaN()),
+        have_end);
     frames.push_back(frame);
   }
   if (!unstamped.empty()) {
@@ -321,7 +309,7 @@ std::vector<FrameToWrite> restamped(const std::vector<FrameToWrite>& frames,
 std::string partialPath(const Options& options) { return options.out + ".partial"; }
 
 void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
-              const std::vector<FrameToWrite>& frames) {
+              const std::vector<FrameToWrite>& frames, const lsf::KittiEgoMotion& ego) {
   const sensor_msgs::CameraInfo left_info_base =
       lsf::rectifiedCameraInfo(calib.camera, kLeftFrame, false);
   const sensor_msgs::CameraInfo right_info_base =
@@ -337,12 +325,22 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
   // tf2's static buffer; a first message time keeps `rosbag play` from waiting).
   ros::Time first = frames.front().image_stamp;
   for (const auto& f : frames) first = std::min({first, f.image_stamp, f.cloud_stamp});
+  if (!ego.samples.empty()) first = std::min(first, ros::Time(ego.samples.front().stamp));
   tf2_msgs::TFMessage tf_static;
   tf_static.transforms.push_back(
       lsf::kittiVelodyneToCamera(calib, kVelodyneFrame, kLeftFrame, first));
   tf_static.transforms.push_back(
       lsf::stereoLeftToRight(calib.camera, kLeftFrame, kRightFrame, first));
+  if (ego.T_velo_imu) {
+    tf_static.transforms.push_back(
+        lsf::kittiImuToVelodyne(*ego.T_velo_imu, kImuFrame, kVelodyneFrame, first));
+  }
   bag.write(kTfStaticTopic, first, tf_static, latchedConnectionHeader<tf2_msgs::TFMessage>());
+  for (const auto& transform : lsf::kittiEgoMotionTf(ego.samples, kFixedFrame, kImuFrame)) {
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(transform);
+    bag.write(kTfTopic, transform.header.stamp, tf);
+  }
 
   uint32_t seq = 0;
   for (const FrameToWrite& frame : frames) {
@@ -378,6 +376,17 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
   fs::rename(partialPath(options), options.out);
 }
 
+/// The drive's ego-motion for the frames' time span (oxts packets not with --period).
+lsf::KittiEgoMotion readEgoMotion(const Options& options, const std::vector<FrameToWrite>& frames) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const FrameToWrite& f : frames) {
+    lo = std::min({lo, f.image_stamp.toSec(), f.cloud_stamp.toSec() - f.sweep.stamp_after_start});
+    hi = std::max({hi, f.image_stamp.toSec(), f.cloud_stamp.toSec()});
+  }
+  return lsf::readKittiEgoMotion(options.calib_dir, options.drive_dir, options.period > 0.0, lo, hi,
+                                 std::cerr);
+}
+
 void removePartial(const Options& options) {
   std::error_code ignored;
   fs::remove(partialPath(options), ignored);
@@ -399,7 +408,7 @@ int main(int argc, char** argv) {
     }
     const lsf::kitti::Calibration calib = lsf::kitti::readCalibration(options.calib_dir);
     const std::vector<FrameToWrite> frames = restamped(selectFrames(options), options);
-    writeBag(options, calib, frames);
+    writeBag(options, calib, frames, readEgoMotion(options, frames));
     std::cout << "kitti_to_bag: wrote " << frames.size() << " frame(s) to " << options.out << "\n";
   } catch (const rosbag::BagException& e) {
     std::cerr << "kitti_to_bag: cannot write bag " << options.out << ": " << e.what() << "\n";

@@ -92,6 +92,24 @@ class SyntheticDrive {
     kitti::writeVelodyneBin((drive_ / "velodyne_points/data" / (name + ".bin")).string(), cloud);
   }
 
+  /// What --deskew reads: calib_imu_to_velo.txt (IMU = Velodyne), the image and sweep stamps
+  /// (the image at the sweep's forward instant) and a packet per frame moving at `vf` [m/s].
+  void writeEgoMotion(double vf) const {
+    std::ofstream(root_ / "2011_01_01" / "calib_imu_to_velo.txt")
+        << "R: 1 0 0 0 1 0 0 0 1\nT: 0 0 0\n";
+    std::ofstream images(drive_ / "image_02/timestamps.txt");
+    std::ofstream starts(drive_ / "velodyne_points/timestamps_start.txt");
+    std::ofstream ends(drive_ / "velodyne_points/timestamps_end.txt");
+    fs::create_directories(drive_ / "oxts/data");
+    for (int i = 0; i < 3; ++i) {
+      images << "2011-01-01 00:00:0" << i << ".050000000\n";
+      starts << "2011-01-01 00:00:0" << i << ".000000000\n";
+      ends << "2011-01-01 00:00:0" << i << ".100000000\n";
+      std::ofstream(drive_ / "oxts/data" / ("000000000" + std::to_string(i) + ".txt"))
+          << "49 8 100 0 0 0 0 0 " << vf << " 0 0 0 0 9.8 0 0 9.8 0 0 0 0 0 0 0.1 0.1 4 7 4 4 0\n";
+    }
+  }
+
   /// 16 lasers from +2 to -28 deg elevation; `behind` keeps only points with x < 0.
   static LidarCloud sweep(bool behind) {
     LidarCloud cloud;
@@ -294,6 +312,65 @@ TEST(KittiRunner, SkippedAndFailedFramesAreNamedAndTheRunGoesOn) {
         << r.err;
     EXPECT_EQ(r.err.find("frames, method"), std::string::npos) << "failed only after starting";
   }
+}
+
+/// Mean of `a - b` over the columns [first, last] where both have depth.
+double meanDifference(const cv::Mat1f& a, const cv::Mat1f& b, int first, int last) {
+  double sum = 0.0;
+  int n = 0;
+  for (int v = 0; v < a.rows; ++v) {
+    for (int u = first; u <= last; ++u) {
+      if (a(v, u) > 0.f && b(v, u) > 0.f) sum += a(v, u) - b(v, u), ++n;
+    }
+  }
+  return n > 0 ? sum / n : NAN;
+}
+
+// --deskew: a standing rig changes nothing; at 10 m/s the sphere's left side (seen before the
+// forward instant) comes nearer, its right side goes farther: a point az to the side, seen
+// az / 360 * 0.1 s from the front, moves by delta = 10 m/s times that along x, and the sphere
+// along a pixel's ray by delta cos^2(az) (8.2 cm and 6.2 cm at 29.5 deg, the image's edges); a
+// frame without its packet is named, processed as measured and makes the exit status 1; a missing
+// calib_imu_to_velo.txt fails the run.
+TEST(KittiRunner, DeskewMovesTheSweepToTheImageInstant) {
+  REQUIRE_RUNNER();
+  SyntheticDrive drive;
+  const std::string raw = drive.outDir().string() + "/raw",
+                    still = drive.outDir().string() + "/still";
+  ASSERT_EQ(drive.run("--out " + raw + " --method lidar_bi").status, 0);
+  drive.writeEgoMotion(0.0);
+  RunResult r = drive.run("--out " + still + " --method lidar_bi --deskew --photometric-check");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("Deskew: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| all (3 frames) |"), std::string::npos) << r.out;
+  const std::string frame0 = "/0000000000.png";
+  EXPECT_EQ(cv::norm(kitti::readDepthPng(raw + frame0), kitti::readDepthPng(still + frame0),
+                     cv::NORM_INF),
+            0.0);
+
+  drive.writeEgoMotion(10.0);
+  const std::string moving = drive.outDir().string() + "/moving";
+  r = drive.run("--out " + moving + " --method lidar_bi --deskew");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const cv::Mat1f before = kitti::readDepthPng(raw + frame0);
+  const cv::Mat1f after = kitti::readDepthPng(moving + frame0);
+  // Column u looks az = atan((40 - u) / 60) to the left: 29.5 deg at u = 6, 34 deg at u = 74.
+  EXPECT_NEAR(meanDifference(after, before, 4, 8), -0.062, 0.01);
+  EXPECT_NEAR(meanDifference(after, before, 38, 42), 0.0, 0.01);
+  EXPECT_NEAR(meanDifference(after, before, 72, 76), 0.062, 0.01);
+
+  fs::remove(drive.drive() / "oxts/data/0000000001.txt");
+  r = drive.run("--out " + moving + " --method lidar_bi --deskew");
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("frame 0000000001 is not deskewed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 of 3 frames not deskewed (processed as measured): 0000000001"),
+            std::string::npos)
+      << r.err;
+  EXPECT_TRUE(fs::exists(moving + "/0000000001.png"));
+  fs::remove(drive.drive().parent_path() / "calib_imu_to_velo.txt");
+  r = drive.run("--out " + moving + " --method lidar_bi --deskew");
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("calib_imu_to_velo.txt"), std::string::npos) << r.err;
 }
 
 }  // namespace

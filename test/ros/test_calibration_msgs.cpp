@@ -9,6 +9,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include "lidar_stereo_fusion/ros/calibration_msgs.h"
+#include "lidar_stereo_fusion/ros/kitti_ego_motion.h"
 
 namespace lsf = lidar_stereo_fusion;
 
@@ -174,6 +175,46 @@ TEST(CalibrationMsgs, RejectsImpossibleTransforms) {
   EXPECT_THROW(lsf::transformMsg(identity, "", "b", ros::Time(0)), std::invalid_argument);
   EXPECT_THROW(lsf::transformMsg(identity, "a", "a", ros::Time(0)), std::invalid_argument);
   EXPECT_NO_THROW(lsf::transformMsg(identity, "a", "b", ros::Time(0)));
+}
+
+// kitti_to_bag's ego-motion: imu -> velodyne is T_velo_imu^-1 (a tf2 lookup of the Velodyne in
+// the IMU frame maps Velodyne points into IMU coordinates); odom -> imu poses relative to the first
+// sample at the samples' stamps; the samples kept are those TF needs over [first, last].
+TEST(CalibrationMsgs, KittiEgoMotionTransforms) {
+  Eigen::Isometry3d T_velo_imu = Eigen::Isometry3d::Identity();
+  T_velo_imu.linear() = Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T_velo_imu.translation() = Eigen::Vector3d(-0.8, 0.3, -0.8);
+  const auto imu_velo = lsf::kittiImuToVelodyne(T_velo_imu, "imu_link", "velodyne", ros::Time(5));
+  EXPECT_EQ(imu_velo.header.frame_id, "imu_link");
+  EXPECT_EQ(imu_velo.child_frame_id, "velodyne");
+  tf2::BufferCore buffer;
+  buffer.setTransform(imu_velo, "test", true);
+  const Eigen::Isometry3d T_imu_velo =
+      tf2::transformToEigen(buffer.lookupTransform("imu_link", "velodyne", ros::Time(0)));
+  EXPECT_TRUE((T_imu_velo * T_velo_imu).isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+
+  std::vector<lsf::kitti::OxtsSample> samples(5);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    samples[i].name = std::to_string(i);
+    samples[i].stamp = 100.0 + 0.1 * static_cast<double>(i);
+    samples[i].packet.lat = 49.0;
+    samples[i].packet.lon = 8.4 + 1e-5 * static_cast<double>(i);  // east, ~0.73 m apart
+  }
+  const auto kept = lsf::samplesBracketing(samples, 100.15, 100.25);
+  ASSERT_EQ(kept.size(), 3u);  // 100.1 .. 100.3
+  EXPECT_EQ(kept.front().name, "1");
+  EXPECT_EQ(kept.back().name, "3");
+  EXPECT_EQ(lsf::samplesBracketing(samples, 100.1, 100.2).size(), 2u);  // on the samples
+  EXPECT_EQ(lsf::samplesBracketing(samples, 90.0, 110.0).size(), 5u);
+  const auto tf = lsf::kittiEgoMotionTf(kept, "odom", "imu_link");
+  ASSERT_EQ(tf.size(), 3u);
+  EXPECT_EQ(tf[0].header.frame_id, "odom");
+  EXPECT_EQ(tf[0].child_frame_id, "imu_link");
+  EXPECT_EQ(tf[2].header.stamp, ros::Time(100.3));
+  EXPECT_EQ(tf[0].transform.translation.x, 0.0);
+  const double east = std::cos(49.0 * M_PI / 180.0) * 1e-5 * M_PI * 6378137.0 / 180.0;
+  EXPECT_NEAR(tf[2].transform.translation.x, 2.0 * east, 1e-6);
+  EXPECT_NEAR(tf[2].transform.translation.y, 0.0, 1e-6);
 }
 
 int main(int argc, char** argv) {

@@ -35,6 +35,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <stereo_msgs/DisparityImage.h>
+#include <tf2/buffer_core.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
 #include <opencv2/imgcodecs.hpp>
@@ -44,6 +45,7 @@
 #include "kitti_bag_util.h"
 #include "lidar_stereo_fusion/FusionStats.h"
 #include "lidar_stereo_fusion/io/kitti.h"
+#include "lidar_stereo_fusion/io/kitti_oxts.h"
 
 namespace fs = std::filesystem;
 namespace kitti = lidar_stereo_fusion::kitti;
@@ -145,6 +147,52 @@ size_t messageCount(const Map& map) {
 
 }  // namespace
 
+/// /tf_static's third transform is imu_link -> velodyne (calib_imu_to_velo.txt inverted); /tf holds
+/// odom -> imu_link at every oxts stamp (all 19 packets bracket the frames 0 .. 50), the devkit
+/// poses relative to the first packet's; through both, TF finds the Velodyne in odom.
+void expectEgoMotion(const std::string& date, const std::string& drive,
+                     const tf2_msgs::TFMessage& tf_static,
+                     const std::vector<rosbag::MessageInstance>& tf_messages) {
+  const geometry_msgs::TransformStamped& imu_velo = tf_static.transforms.at(2);
+  EXPECT_EQ(imu_velo.header.frame_id, "imu_link");
+  EXPECT_EQ(imu_velo.child_frame_id, "velodyne");
+  const Eigen::Isometry3d T_velo_imu = kitti::readImuToVelo(date);
+  EXPECT_TRUE(tf2::transformToEigen(imu_velo).isApprox(T_velo_imu.inverse(), 1e-9));
+  EXPECT_NEAR(imu_velo.transform.translation.x, 0.81, 0.01);  // the IMU is 0.81 m behind
+
+  const auto samples = kitti::readOxtsDrive(drive);
+  const auto poses = kitti::posesRelativeToFirst(samples);
+  ASSERT_EQ(tf_messages.size(), samples.size());
+  tf2::BufferCore buffer(ros::Duration(100.0));
+  buffer.setTransform(imu_velo, "bag", true);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    SCOPED_TRACE(samples[i].name);
+    const auto msg = tf_messages[i].instantiate<tf2_msgs::TFMessage>();
+    ASSERT_TRUE(msg);
+    ASSERT_EQ(msg->transforms.size(), 1u);
+    const geometry_msgs::TransformStamped& t = msg->transforms[0];
+    EXPECT_EQ(t.header.frame_id, "odom");
+    EXPECT_EQ(t.child_frame_id, "imu_link");
+    EXPECT_NEAR(t.header.stamp.toSec(), samples[i].stamp, 1e-6);
+    EXPECT_EQ(tf_messages[i].getTime(), t.header.stamp);
+    EXPECT_TRUE(tf2::transformToEigen(t).isApprox(poses[i], 1e-9));
+    buffer.setTransform(t, "bag");
+  }
+  EXPECT_TRUE(tf2::transformToEigen(
+                  tf_messages.front().instantiate<tf2_msgs::TFMessage>()->transforms.at(0))
+                  .isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+  // Frame 20's image instant, within 2 ms of packet 20 (interpolated from packets 19 and 20): the
+  // Velodyne within centimetres of its pose at packet 20, ~21 m (2 s at ~10.5 m/s) from the start.
+  const ros::Time image20(kittiStamp(drive + "/image_02/timestamps.txt", "0000000020"));
+  const Eigen::Isometry3d odom_velo =
+      tf2::transformToEigen(buffer.lookupTransform("odom", "velodyne", image20));
+  ASSERT_EQ(samples[8].name, "0000000020");  // 0, 5, 10, 15, 16 .. 19, 20
+  const Eigen::Isometry3d at_20 = poses[8] * T_velo_imu.inverse();
+  EXPECT_NEAR((odom_velo.translation() - at_20.translation()).norm(), 0.0, 0.05);
+  EXPECT_GT(at_20.translation().norm(), 18.0);
+  EXPECT_LT(at_20.translation().norm(), 24.0);
+}
+
 TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
   LSF_REQUIRE_DATA(std::string(kDate) + "/" + kDrive);
   const std::string date = lidar_stereo_fusion::test::dataPath(kDate);
@@ -162,7 +210,7 @@ TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
   const kitti::Calibration calib = kitti::readCalibration(date);
   rosbag::Bag bag;
   auto topics = readBag(bag_path, bag);
-  ASSERT_EQ(topics.size(), 6u);
+  ASSERT_EQ(topics.size(), 7u);  // the rig's six and the oxts ego-motion on /tf
   for (const char* topic :
        {"/stereo/left/image_rect_color", "/stereo/left/camera_info",
         "/stereo/right/image_rect_color", "/stereo/right/camera_info", "/velodyne_points"}) {
@@ -178,7 +226,7 @@ TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
   EXPECT_EQ(tf_instance.getConnectionHeader()->at("latching"), "1");
   const auto tf = tf_instance.instantiate<tf2_msgs::TFMessage>();
   ASSERT_TRUE(tf);
-  ASSERT_EQ(tf->transforms.size(), 2u);
+  ASSERT_EQ(tf->transforms.size(), 3u);
   EXPECT_EQ(tf->transforms[0].header.frame_id, "velodyne");
   EXPECT_EQ(tf->transforms[0].child_frame_id, kLeftFrame);
   const Eigen::Vector3d camera_in_velodyne = calib.T_cam_velo.inverse().translation();
@@ -188,6 +236,7 @@ TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
   EXPECT_EQ(tf->transforms[1].header.frame_id, kLeftFrame);
   EXPECT_EQ(tf->transforms[1].child_frame_id, "right_camera_optical_frame");
   EXPECT_NEAR(tf->transforms[1].transform.translation.x, calib.camera.baseline, 1e-9);
+  expectEgoMotion(date, drive, *tf, topics["/tf"]);
 
   for (size_t i = 0; i < frames.size(); ++i) {
     const std::string& name = frames[i].name;
