@@ -20,6 +20,7 @@
 #include "lidar_stereo_fusion/io/holdout.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
+#include "lidar_stereo_fusion/io/pcd.h"
 #include "lidar_stereo_fusion/io/report.h"
 #include "lidar_stereo_fusion/io/visualization.h"
 
@@ -47,6 +48,10 @@ Options:
   --save-vis           also write <out>/vis/<frame>_{sparse,prior,confidence,disparity,depth,
                        error}.png, each with a colour bar in its unit (depth in metres,
                        disparity and error in px, confidence 0 .. 1)
+  --save-pcd           also write <out>/<frame>.pcd: the coloured points of the depth (those of
+                       the node's points2: every pixel with depth, back-projected into the left
+                       optical frame [m], in row-major order), with PCL's writer: fields x y z
+                       rgb, DATA binary_compressed (pcl_viewer, CloudCompare, PCL's converters)
   --frames N           process only the first N frames
   --help               this text
 
@@ -61,6 +66,7 @@ struct Options {
   std::string drive, out, params, reference, holdout = "none";
   std::optional<std::string> method;
   bool save_vis = false;
+  bool save_pcd = false;
   int frames = 0;  // 0 = all
 };
 
@@ -68,7 +74,7 @@ Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(
       argc, argv,
       {"--kitti-raw", "--out", "--method", "--params", "--reference", "--frames", "--holdout"},
-      {"--save-vis", "--help"});
+      {"--save-vis", "--save-pcd", "--help"});
   Options o;
   if (cl.has("--help")) return o;
   o.drive = cl.value("--kitti-raw");
@@ -85,6 +91,7 @@ Options parseOptions(int argc, char** argv) {
     throw lsf::UsageError("--holdout even and --reference exclude each other");
   }
   o.save_vis = cl.has("--save-vis");
+  o.save_pcd = cl.has("--save-pcd");
   o.frames = cl.intValue("--frames", 0, 1, 1000000);
   return o;
 }
@@ -203,6 +210,10 @@ void runFrame(const Options& o, const lsf::kitti::Frame& frame,
                              " (check the sweep and calib_velo_to_cam.txt)");
   }
   lsf::kitti::writeDepthPng((fs::path(o.out) / (frame.name + ".png")).string(), result.depth);
+  if (o.save_pcd) {
+    lsf::pcd::writeColoredPcd((fs::path(o.out) / (frame.name + ".pcd")).string(),
+                              lsf::makeColoredCloud(result.depth, data.left, calib.camera));
+  }
   if (reference) {
     scores.push_back(lsf::evaluateDepth(result.depth, *reference, calib.camera));
     rows.push_back({frame.name, scores.back()});
@@ -266,7 +277,8 @@ int run(const Options& o) {
               << lsf::formatDepthTable(rows) << "\n";
   }
   if (!stats.empty()) std::cout << "Time per stage:\n\n" << lsf::formatTimingSummary(stats);
-  std::cout << "Wrote " << stats.size() << " depth PNGs to " << o.out << "\n";
+  std::cout << "Wrote " << stats.size() << " depth PNGs" << (o.save_pcd ? " and PCD files" : "")
+            << " to " << o.out << "\n";
   if (!failed.empty() || !incomplete.empty()) {
     std::string names;
     for (const auto& name : failed) names += " " + name;
