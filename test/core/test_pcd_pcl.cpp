@@ -138,9 +138,37 @@ TEST(PcdPcl, PclAloneAcceptsBadAsciiThatThisReaderRefuses) {
   }
 }
 
+// Headers on which PCL 1.13's reader crashed (SIGSEGV; found by fuzz/fuzz_pcd.cpp): PCL stops
+// parsing at a line it does not know and reads on without POINTS. Refused here before PCL.
+TEST(PcdPcl, HeadersThatCrashedPclAreRefusedFirst) {
+  const std::string fields = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
+  const std::string rest = "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA binary\n123456789012";
+  const struct {
+    std::string name, bytes, message;
+  } cases[] = {
+      {"nul", std::string("VERSIO\xc8\t\0\0" "7\n", 11) + fields + rest, "holds byte 200"},
+      {"unknown_key", "VIEWPOI 0.7\n" + fields + rest, "unknown line 'VIEWPOI ...'"},
+      {"no_points", fields + "WIDTH 1\nHEIGHT 1\nPODATA 1\nDATA binary\n123456789012",
+       "unknown line 'PODATA ...'"},
+      {"points_missing", fields + "WIDTH 1\nHEIGHT 1\nDATA binary\n123456789012", "no POINTS"},
+      {"blank_line", fields + "   \n" + rest, "holds only blanks"},
+      {"viewpoint", fields + "VIEWPOINT 0 0 0\n" + rest, "VIEWPOINT needs 7 numbers"},
+  };
+  for (const auto& c : cases) {
+    const std::string path = tempPath(c.name + ".pcd");
+    writeBytes(path, c.bytes);
+    const std::string error = readError(path);
+    EXPECT_NE(error.find(c.message), std::string::npos) << c.name << ": '" << error << "'";
+  }
+}
+
 TEST(PcdPcl, UnknownDataKindIsNamed) {
   writeBytes(tempPath("zip.pcd"),
              "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nPOINTS 1\nDATA zip\n");
+  // and a header of known lines in an order PCL refuses (COUNT before TYPE) is PCL's refusal
+  writeBytes(tempPath("order.pcd"), "FIELDS x y z\nSIZE 4 4 4\nCOUNT 1 1 1\nTYPE F F F\nWIDTH 1\n"
+                                    "POINTS 1\nDATA ascii\n1 2 3\n");
+  EXPECT_NE(readError(tempPath("order.pcd")).find("PCL's reader refused"), std::string::npos);
   EXPECT_NE(readError(tempPath("zip.pcd")).find("unknown DATA 'zip'"), std::string::npos);
 }
 

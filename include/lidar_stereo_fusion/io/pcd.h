@@ -5,8 +5,9 @@
 // COUNT >= 1. Binary data is in the host byte order (little-endian on every platform we build
 // for), as PCL writes it. VIEWPOINT is ignored: points are returned in the file's frame.
 // This package parses the header and checks the data's size (and every ascii value) before PCL
-// reads the file, so that a bad file is refused with a message naming the problem; PCL alone
-// accepts ascii words that are no numbers and lines with missing values (test/core/test_pcd.cpp).
+// reads the file, so that a bad file is refused with a message naming the problem: PCL alone
+// accepts ascii words that are no numbers and lines with missing values, and crashed on headers
+// with a NUL byte or an unknown line (test/core/test_pcd_pcl.cpp, doc/libraries.md).
 #pragma once
 
 #include <string>
@@ -38,7 +39,8 @@ struct Header {
 /// field with COUNT > 1 contributes its first element. Non-finite points are kept (an organised
 /// cloud marks missing returns with NaN); later stages skip them. If `header` is given it receives
 /// the parsed header. Throws std::runtime_error naming the file and the problem (unreadable file,
-/// malformed or inconsistent header, missing x/y/z, truncated or corrupt data, unknown DATA).
+/// malformed or inconsistent header (not ASCII, an unknown line, no POINTS, ...), missing x/y/z,
+/// truncated or corrupt data, unknown DATA).
 LidarCloud readPcd(const std::string& path, Header* header = nullptr);
 
 /// The DATA kinds of a PCD file.
