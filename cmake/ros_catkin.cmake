@@ -7,6 +7,10 @@ set(LSF_CATKIN_COMPONENTS
   image_transport sensor_msgs stereo_msgs std_msgs geometry_msgs dynamic_reconfigure
   diagnostic_updater diagnostic_msgs rosbag message_generation)
 find_package(catkin REQUIRED COMPONENTS ${LSF_CATKIN_COMPONENTS})
+# pcl_conversions (header-only): the tests that compare this package's PointCloud2 checks and the
+# pcl_ros filters with PCL's own conversion. The nodelet itself reads clouds without it
+# (doc/libraries.md says why).
+find_package(pcl_conversions REQUIRED)
 
 add_message_files(DIRECTORY msg FILES FusionStats.msg)
 generate_messages(DEPENDENCIES std_msgs)

@@ -79,6 +79,15 @@ if(TARGET kitti_runner)
   target_include_directories(test_playback SYSTEM PRIVATE
     ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})  # FusionStats.h
   target_compile_definitions(test_playback PRIVATE LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
+  # Issue 26: pcl_ros's CropBox (sweep) and VoxelGrid (points2) in the fusion's manager.
+  lsf_add_tools_rostest(test_pcl_filters test/ros/pcl_filters.test
+    SOURCES test/ros/test_pcl_filters.cpp test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
+    DEPENDS kitti_to_bag ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
+  target_include_directories(test_pcl_filters SYSTEM PRIVATE
+    ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION} ${PCL_INCLUDE_DIRS}
+    ${pcl_conversions_INCLUDE_DIRS})
+  target_link_libraries(test_pcl_filters pcl_filters pcl_common)
+  target_compile_definitions(test_pcl_filters PRIVATE LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
 else()
   message(WARNING "no kitti_runner target (tools/kitti_runner.cpp): test/ros/kitti_bag.test is "
                   "not registered")

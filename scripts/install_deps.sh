@@ -6,7 +6,7 @@ set -euo pipefail
 PKGS=(
   build-essential cmake pkg-config python3-catkin-pkg python3-empy catkin
   ros-base-dev libnodeletlib-dev pluginlib-dev
-  libpcl-ros-dev libpcl-conversions-dev libpcl-dev
+  libpcl-ros-dev libpcl-conversions-dev libpcl-dev libpcl-ros-filters0d pcl-tools
   libcv-bridge-dev libimage-transport-dev libimage-geometry-dev
   libtf2-ros-dev libtf2-eigen-dev libtf2-sensor-msgs-dev
   libmessage-filters-dev librosbag-dev python3-rosbag

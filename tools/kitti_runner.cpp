@@ -23,6 +23,7 @@
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/kitti_sweep.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
+#include "lidar_stereo_fusion/io/pcd.h"
 #include "lidar_stereo_fusion/io/photometric_check.h"
 #include "lidar_stereo_fusion/io/report.h"
 #include "lidar_stereo_fusion/io/visualization.h"
@@ -58,6 +59,10 @@ Options:
   --photometric-check  per frame, the best shift delta in [-3, 3] px of image_03 at (u - d + delta,
                        v) for image_02 at each LiDAR pixel (u, v, d): median delta, median |delta|,
                        share of |delta| <= 0.5 px; with --deskew before and after
+  --save-pcd           also write <out>/<frame>.pcd: the coloured points of the depth (those of
+                       the node's points2: every pixel with depth, back-projected into the left
+                       optical frame [m], in row-major order), with PCL's writer: fields x y z
+                       rgb, DATA binary_compressed (pcl_viewer, CloudCompare, PCL's converters)
   --frames N           process only the first N frames
   --help               this text
 
@@ -71,7 +76,7 @@ drive, parameters, unwritable output folder), 2 on a bad command line.
 struct Options {
   std::string drive, out, params, reference, holdout = "none";
   std::optional<std::string> method;
-  bool save_vis = false, deskew = false, photometric_check = false;
+  bool save_vis = false, deskew = false, photometric_check = false, save_pcd = false;
   int frames = 0;  // 0 = all
 };
 
@@ -96,7 +101,7 @@ Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(
       argc, argv,
       {"--kitti-raw", "--out", "--method", "--params", "--reference", "--frames", "--holdout"},
-      {"--save-vis", "--deskew", "--photometric-check", "--help"});
+      {"--save-vis", "--save-pcd", "--deskew", "--photometric-check", "--help"});
   Options o;
   if (cl.has("--help")) return o;
   o.drive = cl.value("--kitti-raw");
@@ -115,6 +120,7 @@ Options parseOptions(int argc, char** argv) {
   o.save_vis = cl.has("--save-vis");
   o.deskew = cl.has("--deskew");
   o.photometric_check = cl.has("--photometric-check");
+  o.save_pcd = cl.has("--save-pcd");
   o.frames = cl.intValue("--frames", 0, 1, 1000000);
   return o;
 }
@@ -283,6 +289,10 @@ void runFrame(const Context& c, const lsf::kitti::Frame& frame, lsf::FusionPipel
                              " (check the sweep and calib_velo_to_cam.txt)");
   }
   lsf::kitti::writeDepthPng((fs::path(o.out) / (frame.name + ".png")).string(), result.depth);
+  if (o.save_pcd) {
+    lsf::pcd::writeColoredPcd((fs::path(o.out) / (frame.name + ".pcd")).string(),
+                              lsf::makeColoredCloud(result.depth, data.left, calib.camera));
+  }
   if (reference) {
     results.scores.push_back(lsf::evaluateDepth(result.depth, *reference, calib.camera));
     results.rows.push_back({frame.name, results.scores.back()});
@@ -374,7 +384,8 @@ int run(const Options& o) {
     std::cout << "Time per stage:\n\n" << lsf::formatTimingSummary(results.stats);
   }
   printChecks(o, results);
-  std::cout << "Wrote " << results.stats.size() << " depth PNGs to " << o.out << "\n";
+  std::cout << "Wrote " << results.stats.size() << " depth PNGs"
+            << (o.save_pcd ? " and PCD files" : "") << " to " << o.out << "\n";
   if (!results.undeskewed.empty()) {
     std::string names;
     for (const auto& name : results.undeskewed) names += " " + name;

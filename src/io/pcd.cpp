@@ -1,4 +1,4 @@
-// PCD reader/writer (ascii and binary) without PCL.
+// PCD reader/writer: this package's header and data checks in front of PCL's reader and writer.
 #include "lidar_stereo_fusion/io/pcd.h"
 
 #include <algorithm>
@@ -11,6 +11,9 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/io/pcd_io.h>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 
@@ -49,45 +52,98 @@ int parseCount(const std::string& path, const std::string& key, const std::strin
   return static_cast<int>(value);
 }
 
+/// A header is ASCII text: PCL 1.13's reader crashed (SIGSEGV) on a header line holding a NUL
+/// byte (found by fuzz/fuzz_pcd.cpp), so control and non-ASCII bytes are refused before PCL sees
+/// the file.
+void requireText(const std::string& path, const std::string& line, int number) {
+  for (const char c : line) {
+    const auto byte = static_cast<unsigned char>(c);
+    if ((byte < 0x20 && c != '\t') || byte > 0x7e) {
+      fail(path, "header line " + std::to_string(number) + " holds byte " + std::to_string(byte) +
+                     " (a PCD header is ASCII text; binary data before DATA?)");
+    }
+  }
+}
+
+/// A value of one of WIDTH, HEIGHT, POINTS: exactly one.
+const std::string& single(const std::string& path, const std::string& key,
+                          const std::vector<std::string>& values) {
+  if (values.size() != 1) {
+    fail(path, "header " + key + " has " + std::to_string(values.size()) + " values, not one");
+  }
+  return values[0];
+}
+
+void parseViewpoint(const std::string& path, const std::vector<std::string>& values) {
+  bool numbers = values.size() == 7;
+  for (const std::string& v : values) {
+    char* end = nullptr;
+    std::strtod(v.c_str(), &end);
+    numbers = numbers && end != v.c_str() && *end == '\0';
+  }
+  if (!numbers) fail(path, "header VIEWPOINT needs 7 numbers (tx ty tz qw qx qy qz)");
+}
+
+/// Reads one header line's key and values into `header`; true at DATA. PCL's reader stops at
+/// the first line it does not know and then reads the file without POINTS (it crashed on such a
+/// file, found by fuzzing): every line must be one it knows, a comment or empty.
+bool parseHeaderLine(const std::string& path, const std::vector<std::string>& words,
+                     Header& header, bool& have_points) {
+  const std::string& key = words[0];
+  const std::vector<std::string> values(words.begin() + 1, words.end());
+  if (key == "VERSION") {
+    header.version = values.empty() ? "" : values[0];
+  } else if (key == "FIELDS" || key == "COLUMNS") {
+    header.fields = values;
+  } else if (key == "SIZE") {
+    for (const auto& v : values) header.sizes.push_back(parseCount(path, key, v));
+  } else if (key == "TYPE") {
+    for (const auto& v : values) {
+      if (v.size() != 1 || (v[0] != 'F' && v[0] != 'I' && v[0] != 'U')) {
+        fail(path, "header TYPE '" + v + "' is not F, I or U");
+      }
+      header.types.push_back(v[0]);
+    }
+  } else if (key == "COUNT") {
+    for (const auto& v : values) header.counts.push_back(parseCount(path, key, v));
+  } else if (key == "WIDTH") {
+    header.width = parseCount(path, key, single(path, key, values));
+  } else if (key == "HEIGHT") {
+    header.height = parseCount(path, key, single(path, key, values));
+  } else if (key == "POINTS") {
+    const long long points = parseInteger(path, key, single(path, key, values));
+    if (points < 0) fail(path, "header POINTS is negative");
+    header.points = static_cast<std::size_t>(points);
+    have_points = true;
+  } else if (key == "VIEWPOINT") {
+    parseViewpoint(path, values);  // checked, not used: points stay in the file's frame
+  } else if (key == "DATA") {
+    header.data = values.empty() ? "" : values[0];
+    return true;
+  } else {
+    fail(path, "header has an unknown line '" + key + " ...' (a PCD header holds VERSION, "
+                   "FIELDS, SIZE, TYPE, COUNT, WIDTH, HEIGHT, VIEWPOINT, POINTS, DATA)");
+  }
+  return false;
+}
+
 /// Parses header lines up to and including DATA; leaves `in` at the first data byte.
 Header readHeader(std::istream& in, const std::string& path) {
   Header header;
   bool have_points = false;
   std::string line;
+  int number = 0;
   while (std::getline(in, line)) {
+    ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    requireText(path, line, number);
+    if (line.empty()) continue;
     const std::vector<std::string> words = splitWords(line);
-    if (words.empty() || words[0][0] == '#') continue;
-    const std::string& key = words[0];
-    const std::vector<std::string> values(words.begin() + 1, words.end());
-    if (key == "VERSION") {
-      header.version = values.empty() ? "" : values[0];
-    } else if (key == "FIELDS" || key == "COLUMNS") {
-      header.fields = values;
-    } else if (key == "SIZE") {
-      for (const auto& v : values) header.sizes.push_back(parseCount(path, key, v));
-    } else if (key == "TYPE") {
-      for (const auto& v : values) {
-        if (v.size() != 1 || (v[0] != 'F' && v[0] != 'I' && v[0] != 'U')) {
-          fail(path, "header TYPE '" + v + "' is not F, I or U");
-        }
-        header.types.push_back(v[0]);
-      }
-    } else if (key == "COUNT") {
-      for (const auto& v : values) header.counts.push_back(parseCount(path, key, v));
-    } else if (key == "WIDTH" && values.size() == 1) {
-      header.width = parseCount(path, key, values[0]);
-    } else if (key == "HEIGHT" && values.size() == 1) {
-      header.height = parseCount(path, key, values[0]);
-    } else if (key == "POINTS" && values.size() == 1) {
-      const long long points = parseInteger(path, key, values[0]);
-      if (points < 0) fail(path, "header POINTS is negative");
-      header.points = static_cast<std::size_t>(points);
-      have_points = true;
-    } else if (key == "DATA") {
-      header.data = values.empty() ? "" : values[0];
-      break;
-    }  // VIEWPOINT and unknown keys are ignored
+    if (words.empty()) {
+      fail(path, "header line " + std::to_string(number) + " holds only blanks");
+    }
+    if (words[0][0] == '#') continue;
+    if (parseHeaderLine(path, words, header, have_points)) break;
   }
   if (header.data.empty()) fail(path, "no DATA line (not a PCD file, or truncated header)");
   if (header.fields.empty()) fail(path, "header has no FIELDS");
@@ -111,7 +167,7 @@ Header readHeader(std::istream& in, const std::string& path) {
   }
   if (header.height == 0) header.height = 1;
   const std::size_t grid = static_cast<std::size_t>(header.width) * header.height;
-  if (!have_points) header.points = grid;
+  if (!have_points) fail(path, "header has no POINTS");
   if (header.points != grid) {
     fail(path, "header POINTS (" + std::to_string(header.points) + ") != WIDTH * HEIGHT (" +
                    std::to_string(grid) + ")");
@@ -208,62 +264,94 @@ std::size_t remainingBytes(std::istream& in) {
   return here < 0 || end < here ? 0 : static_cast<std::size_t>(end - here);
 }
 
-LidarCloud readBinary(std::istream& in, const Header& header, const Layout& layout,
-                      const std::string& path) {
+void checkBinary(std::istream& in, const Header& header, const Layout& layout,
+                 const std::string& path) {
   const std::size_t available = remainingBytes(in);
   if (header.points > available / layout.stride) {
     fail(path, "binary data is truncated: " + std::to_string(header.points) + " points of " +
                    std::to_string(layout.stride) + " bytes need more than the " +
                    std::to_string(available) + " bytes left");
   }
-  std::vector<unsigned char> bytes(header.points * layout.stride);
-  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (static_cast<std::size_t>(in.gcount()) != bytes.size()) {
-    fail(path, "binary data is truncated: expected " + std::to_string(bytes.size()) +
-                   " bytes for " + std::to_string(header.points) + " points, got " +
-                   std::to_string(in.gcount()));
-  }
-  LidarCloud cloud;
-  cloud.reserve(header.points);
-  for (std::size_t i = 0; i < header.points; ++i) {
-    const unsigned char* record = bytes.data() + i * layout.stride;
-    cloud.push_back(makePoint(layout, [&](int f) {
-      return decodeBinary(record + layout.offset[f], header.types[f], header.sizes[f]);
-    }));
-  }
-  return cloud;
 }
 
-LidarCloud readAscii(std::istream& in, const Header& header, const Layout& layout,
+/// The two size words in front of LZF data: PCL checks them too, but only says "corrupted"; these
+/// messages name the numbers, and an impossible size is refused before anything is allocated.
+void checkCompressed(std::istream& in, const Header& header, const Layout& layout,
                      const std::string& path) {
-  LidarCloud cloud;
-  // Every value takes at least two characters ("0 "): never reserve more than the file can hold.
-  cloud.reserve(std::min(header.points, remainingBytes(in) / (2 * layout.tokens)));
-  std::vector<double> numbers(layout.tokens);
+  const std::size_t available = remainingBytes(in);
+  uint32_t sizes[2] = {0, 0};  // compressed, uncompressed [bytes]
+  if (available < sizeof(sizes)) {
+    fail(path, "DATA binary_compressed is truncated: no compressed and uncompressed sizes");
+  }
+  in.read(reinterpret_cast<char*>(sizes), sizeof(sizes));
+  if (sizes[0] > available - sizeof(sizes)) {
+    fail(path, "DATA binary_compressed is truncated: " + std::to_string(sizes[0]) +
+                   " compressed bytes announced, " + std::to_string(available - sizeof(sizes)) +
+                   " left");
+  }
+  const uint64_t expected = static_cast<uint64_t>(header.points) * layout.stride;
+  if (sizes[1] != expected) {
+    fail(path, "DATA binary_compressed: uncompressed size " + std::to_string(sizes[1]) +
+                   " bytes, but " + std::to_string(header.points) + " points of " +
+                   std::to_string(layout.stride) + " bytes need " + std::to_string(expected));
+  }
+  // An LZF back reference (3 bytes) expands to at most 264 bytes.
+  constexpr uint64_t kLzfMaxRatio = 88;
+  if (expected > kLzfMaxRatio * sizes[0] + kLzfMaxRatio) {
+    fail(path, "DATA binary_compressed: " + std::to_string(sizes[0]) +
+                   " compressed bytes cannot hold " + std::to_string(expected) + " bytes");
+  }
+}
+
+/// Checks every ascii value. Hand-written on purpose: PCL's reader returns success with 0 for a
+/// word that is no number ("1 2 x") and for missing values ("1 2" under three fields); see
+/// test/core/test_pcd.cpp, Pcl* tests.
+void checkAscii(std::istream& in, const Header& header, const Layout& layout,
+                const std::string& path) {
+  std::size_t points = 0;
   std::string line;
-  while (cloud.size() < header.points && std::getline(in, line)) {
+  while (points < header.points && std::getline(in, line)) {
     const std::vector<std::string> words = splitWords(line);
     if (words.empty()) continue;
     if (words.size() != layout.tokens) {
-      fail(path, "ascii point " + std::to_string(cloud.size()) + " has " +
-                     std::to_string(words.size()) + " values, the header says " +
-                     std::to_string(layout.tokens));
+      fail(path, "ascii point " + std::to_string(points) + " has " + std::to_string(words.size()) +
+                     " values, the header says " + std::to_string(layout.tokens));
     }
-    for (std::size_t k = 0; k < words.size(); ++k) {
+    for (const std::string& word : words) {
       char* end = nullptr;
-      numbers[k] = std::strtod(words[k].c_str(), &end);
-      if (end == words[k].c_str() || *end != '\0') {
-        fail(path, "ascii point " + std::to_string(cloud.size()) + " has a non-number '" +
-                       words[k] + "'");
+      std::strtod(word.c_str(), &end);
+      if (end == word.c_str() || *end != '\0') {
+        fail(path, "ascii point " + std::to_string(points) + " has a non-number '" + word + "'");
       }
     }
-    cloud.push_back(makePoint(layout, [&](int f) { return numbers[layout.column[f]]; }));
+    ++points;
   }
-  if (cloud.size() != header.points) {
-    fail(path, "ascii data is truncated: " + std::to_string(cloud.size()) + " of " +
+  if (points != header.points) {
+    fail(path, "ascii data is truncated: " + std::to_string(points) + " of " +
                    std::to_string(header.points) + " points");
   }
-  return cloud;
+}
+
+/// The points of a cloud PCL read, after checking that PCL saw the layout our header gave.
+LidarCloud toLidarCloud(const pcl::PCLPointCloud2& cloud, const Header& header,
+                        const Layout& layout, const std::string& path) {
+  const std::size_t points = static_cast<std::size_t>(cloud.width) * cloud.height;
+  bool same = points == header.points && cloud.point_step == layout.stride &&
+              cloud.fields.size() == header.fields.size() &&
+              cloud.data.size() >= points * layout.stride;
+  for (std::size_t i = 0; same && i < cloud.fields.size(); ++i) {
+    same = cloud.fields[i].name == header.fields[i] && cloud.fields[i].offset == layout.offset[i];
+  }
+  if (!same) fail(path, "PCL's reader saw another layout than the header (corrupt header?)");
+  LidarCloud out;
+  out.reserve(points);
+  for (std::size_t i = 0; i < points; ++i) {
+    const unsigned char* record = cloud.data.data() + i * layout.stride;
+    out.push_back(makePoint(layout, [&](int f) {
+      return decodeBinary(record + layout.offset[f], header.types[f], header.sizes[f]);
+    }));
+  }
+  return out;
 }
 
 }  // namespace
@@ -278,51 +366,33 @@ LidarCloud readPcd(const std::string& path, Header* header_out) {
   const Header header = readHeader(in, path);
   const Layout layout = makeLayout(header, path);
   if (header_out) *header_out = header;
-  if (header.data == "binary") return readBinary(in, header, layout, path);
-  if (header.data == "ascii") return readAscii(in, header, layout, path);
-  if (header.data == "binary_compressed") {
-    fail(path,
-         "DATA binary_compressed is not supported; convert with pcl_convert_pcd_ascii_binary "
-         "<in> <out> 1 (binary)");
-  }
-  fail(path, "unknown DATA '" + header.data + "' (expected ascii or binary)");
-}
-
-void writePcd(const std::string& path, const LidarCloud& cloud, bool binary) {
-  const bool with_ring = !cloud.empty() && hasRings(cloud);
-  for (const LidarPoint& p : cloud) {
-    if (with_ring && p.ring > std::numeric_limits<uint16_t>::max()) {
-      fail(path, "ring " + std::to_string(p.ring) + " does not fit uint16");
-    }
-  }
-  std::ofstream out(path, std::ios::binary);
-  if (!out) fail(path, "cannot open file for writing");
-  out << "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n";
-  out << (with_ring ? "FIELDS x y z intensity ring time\nSIZE 4 4 4 4 2 4\nTYPE F F F F U F\n"
-                      "COUNT 1 1 1 1 1 1\n"
-                    : "FIELDS x y z intensity time\nSIZE 4 4 4 4 4\nTYPE F F F F F\n"
-                      "COUNT 1 1 1 1 1\n");
-  out << "WIDTH " << cloud.size() << "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " << cloud.size()
-      << "\nDATA " << (binary ? "binary" : "ascii") << "\n";
-  if (binary) {
-    for (const LidarPoint& p : cloud) {
-      const float xyzi[4] = {p.x, p.y, p.z, p.intensity};
-      out.write(reinterpret_cast<const char*>(xyzi), sizeof(xyzi));
-      if (with_ring) {
-        const uint16_t ring = static_cast<uint16_t>(p.ring);
-        out.write(reinterpret_cast<const char*>(&ring), sizeof(ring));
-      }
-      out.write(reinterpret_cast<const char*>(&p.time), sizeof(p.time));
-    }
+  // This package's checks first (their messages name the problem), then PCL's reader.
+  if (header.data == "binary") {
+    checkBinary(in, header, layout, path);
+  } else if (header.data == "binary_compressed") {
+    checkCompressed(in, header, layout, path);
+  } else if (header.data == "ascii") {
+    checkAscii(in, header, layout, path);
   } else {
-    out.precision(std::numeric_limits<float>::max_digits10);
-    for (const LidarPoint& p : cloud) {
-      out << p.x << ' ' << p.y << ' ' << p.z << ' ' << p.intensity;
-      if (with_ring) out << ' ' << p.ring;
-      out << ' ' << p.time << '\n';
-    }
+    fail(path, "unknown DATA '" + header.data + "' (expected ascii, binary or binary_compressed)");
   }
-  if (!out) fail(path, "write failed");
+  in.close();
+  pcl::PCLPointCloud2 cloud;
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  int version = 0;
+  int status = -1;
+  try {
+    status = pcl::PCDReader().read(path, cloud, origin, orientation, version);
+  } catch (const std::exception& e) {  // pcl::IOException
+    fail(path, std::string("PCL's reader: ") + e.what());
+  }
+  if (status < 0) {
+    fail(path, "PCL's reader refused the DATA " + header.data +
+                   (header.data == "binary_compressed" ? " (corrupt LZF data?)" : "") +
+                   ", status " + std::to_string(status));
+  }
+  return toLidarCloud(cloud, header, layout, path);
 }
 
 }  // namespace pcd

@@ -130,6 +130,9 @@ TEST(FuzzSeeds, ParamsYamlAndPcd) {
     pcd::writePcd(pcdPath.string(), smallSweep(), binary);
     EXPECT_EQ(pcd::readPcd(pcdPath.string()).size(), 64u) << pcdPath;
   }
+  const fs::path compressed = seedDir("pcd") / "binary_compressed.pcd";  // LZF, through PCL
+  pcd::writePcd(compressed.string(), smallSweep(), pcd::DataKind::kBinaryCompressed);
+  EXPECT_EQ(pcd::readPcd(compressed.string()).size(), 64u) << compressed;
 }
 
 }  // namespace

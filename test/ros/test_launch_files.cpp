@@ -67,3 +67,26 @@ TEST(LaunchFiles, PresetLiveLoadsConfigLiveEverywhere) {
   const std::string rig = dumpParams("zed_vls128.launch", "preset:=fusion");
   EXPECT_NE(rig.find("/fusion/fusion/search_scale: 1"), std::string::npos) << rig;
 }
+
+TEST(LaunchFiles, PclFiltersAreOffByDefaultAndPassedThroughFromRigAndPlayback) {
+  // Off: no filter node and the fusion reads the sweep topic itself.
+  const std::string plain = dumpParams("fusion.launch");
+  EXPECT_EQ(plain.find("/fusion/self_filter/"), std::string::npos) << plain;
+  EXPECT_EQ(plain.find("/fusion/points2_voxel_grid/"), std::string::npos) << plain;
+  const std::string box = "self_filter_min:='-3 -1.5 -2.5' self_filter_max:='1.5 1.5 0.5' ";
+  for (const auto& [launch, args] :
+       {std::pair<std::string, std::string>{"fusion.launch", ""},
+        {"playback.launch", "bag:=/nonexistent.bag "},
+        {"zed_vls128.launch", ""}}) {
+    const std::string dump = dumpParams(launch, args + box + "voxel_leaf_size:=0.25");
+    for (const char* expected :
+         {"/fusion/self_filter/negative: true", "/fusion/self_filter/min_x: -3.0",
+          "/fusion/self_filter/min_y: -1.5", "/fusion/self_filter/min_z: -2.5",
+          "/fusion/self_filter/max_x: 1.5", "/fusion/self_filter/max_y: 1.5",
+          "/fusion/self_filter/max_z: 0.5", "/fusion/points2_voxel_grid/leaf_size: 0.25",
+          "/fusion/points2_voxel_grid/filter_field_name: ''"}) {
+      EXPECT_NE(dump.find(expected), std::string::npos) << launch << ": " << expected << "\n"
+                                                        << dump;
+    }
+  }
+}
