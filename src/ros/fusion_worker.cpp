@@ -173,6 +173,7 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
     log_.warn(kCloud, "tf",
               "no transform from '" + lidar_frame + "' (" + topicName(kCloud) + ") to '" +
                   camera_frame + "' (" + topicName(kLeftImage) + ") at " +
+                  (node_params_.fixed_frame.empty() ? "sweep stamp " : "image stamp ") +
                   stampText(extrinsics_stamp) + " within " +
                   std::to_string(node_params_.tf_timeout) + " s: " + e.what() + "; frame skipped");
     return;
