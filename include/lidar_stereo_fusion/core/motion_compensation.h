@@ -48,8 +48,9 @@ SweepMotion constantVelocityMotion(const Eigen::Vector3d& velocity,
                                    const std::vector<double>& times);
 
 /// Moves every point of `cloud` (LiDAR frame, [m]) from its time to the target instant of
-/// `motion`: p' = motion.at(p.time) * p, the rotation interpolated by normalised lerp (the same as
-/// at()'s slerp to within 1e-9 rad for the sub-degree rotations between samples). Non-finite
+/// `motion`: p' = motion.at(p.time) * p, the rotation interpolated by normalised lerp: it differs
+/// from at()'s slerp by about theta^3 / 60 for a rotation theta [rad] between neighbouring samples
+/// (3e-8 rad at 0.7 deg, a car's yaw over 25 ms in a tight bend). Non-finite
 /// points stay as they are (the projection skips them). Throws std::invalid_argument if
 /// motion.validate() fails.
 void compensateMotion(LidarCloud& cloud, const SweepMotion& motion);
