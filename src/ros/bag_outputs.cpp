@@ -46,9 +46,7 @@ std::string csvField(const std::string& text) {
 }
 
 /// A temporary name beside `path` (same folder, so the rename is atomic).
-std::string tempPath(const std::string& path) {
-  return path + ".tmp" + std::to_string(::getpid());
-}
+std::string tempPath(const std::string& path) { return path + ".tmp" + std::to_string(::getpid()); }
 
 void writeImageAtomically(const std::string& path, const cv::Mat& image) {
   const std::string tmp = tempPath(path) + ".png";
@@ -220,9 +218,9 @@ void OutputWriter::write(const InputMatch& match, const ros::Time& receipt, cons
               conversions::organizedCloudToMsg(set.depth, set.left, set.camera,
                                                node_params_.cloud_stride, header));
   const cv::Mat1f zeros = cv::Mat1f::zeros(set.camera.height, set.camera.width);
-  bag_->write(topic("lidar_disparity"), t,
-              conversions::floatImageToMsg(set.result.prior.empty() ? zeros : set.result.prior,
-                                           header));
+  bag_->write(
+      topic("lidar_disparity"), t,
+      conversions::floatImageToMsg(set.result.prior.empty() ? zeros : set.result.prior, header));
   bag_->write(topic("confidence"), t,
               conversions::floatImageToMsg(
                   set.result.confidence.empty() ? zeros : set.result.confidence, header));

@@ -36,8 +36,7 @@ BagPairing::BagPairing(const NodeParams& params, const BagTopics& topics)
   using boost::placeholders::_2;
   using boost::placeholders::_3;
   using boost::placeholders::_4;
-  sync_ = std::make_unique<StereoSync>(params_, left_image_, left_info_, right_image_,
-                                       right_info_,
+  sync_ = std::make_unique<StereoSync>(params_, left_image_, left_info_, right_image_, right_info_,
                                        boost::bind(&BagPairing::onSet, this, _1, _2, _3, _4),
                                        boost::bind(&BagPairing::onDrop, this, _1, _2, _3, _4));
 }
@@ -74,7 +73,8 @@ void BagPairing::add(const rosbag::MessageInstance& m) {
         .add(ros::MessageEvent<const Info>(info, now_));
   } else if (topic == topics_.cloud) {
     const auto cloud = m.instantiate<sensor_msgs::PointCloud2>();
-    if (!cloud) throw std::runtime_error(topic + " holds " + m.getDataType() + ", not a PointCloud2");
+    if (!cloud)
+      throw std::runtime_error(topic + " holds " + m.getDataType() + ", not a PointCloud2");
     if (const auto rejection = checkCloud(*cloud)) {
       refused_sweep_stamp_ = cloud->header.stamp;
       refused_sweep_problem_ = rejection->problem;
@@ -93,10 +93,11 @@ void BagPairing::finish() {
   InputMatcher::Events events = matcher_.poll(end);
   handle(events);
   for (const auto& kv : open_) {  // never completed by the synchroniser
-    decided_.push_back({kv.first, kv.second, boost::none,
-                        std::string("incomplete image set: no right image and camera_infos ") +
-                            (params_.approximate_sync ? "near its stamp"
-                                                      : "with the same stamp (approximate_sync?)")});
+    decided_.push_back(
+        {kv.first, kv.second, boost::none,
+         std::string("incomplete image set: no right image and camera_infos ") +
+             (params_.approximate_sync ? "near its stamp"
+                                       : "with the same stamp (approximate_sync?)")});
   }
   open_.clear();
 }
@@ -141,9 +142,8 @@ void BagPairing::handle(InputMatcher::Events& events) {
   for (std::size_t i = 0; i < events.unmatched.size(); ++i) {
     const ros::Time& stamp = events.unmatched[i];
     std::string reason;
-    if (!refused_sweep_stamp_.isZero() &&
-        std::abs((refused_sweep_stamp_ - stamp).toSec()) <=
-            params_.max_time_offset + params_.max_sweep_wait) {
+    if (!refused_sweep_stamp_.isZero() && std::abs((refused_sweep_stamp_ - stamp).toSec()) <=
+                                              params_.max_time_offset + params_.max_sweep_wait) {
       reason = "no usable sweep: the sweep at " + stampName(refused_sweep_stamp_) +
                " was refused (" + refused_sweep_problem_ + ")";
     } else if (events.unmatched_waited[i]) {

@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/core/persistence.hpp>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <tf2/exceptions.h>
 #include <tf2_eigen/tf2_eigen.h>
+#include <opencv2/core/persistence.hpp>
 
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
@@ -31,7 +31,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const char* const kUsage = R"(Usage: bag_runner --bag FILE [--bag FILE ...] --out DIR [options] [NAME:=TOPIC ...]
+const char* const kUsage =
+    R"(Usage: bag_runner --bag FILE [--bag FILE ...] --out DIR [options] [NAME:=TOPIC ...]
 
 Runs LiDAR-stereo fusion on every image set of a recorded drive (several --bag files are read as
 one recording) and writes DIR/<sec>.<nsec>.png per set (the left image stamp; KITTI depth format:
@@ -89,12 +90,14 @@ Options parseOptions(int argc, char** argv) {
     } else if (a.find(":=") != std::string::npos && a.rfind("--", 0) != 0) {
       const std::string from = a.substr(0, a.find(":=")), to = a.substr(a.find(":=") + 2);
       if (to.empty()) throw lsf::UsageError("remap " + a + " has no topic");
-      if (from == "left/image_rect_color") o.topics.left_image = to;
-      else if (from == "left/camera_info") o.topics.left_info = to;
-      else if (from == "right/image_rect_color") o.topics.right_image = to;
-      else if (from == "right/camera_info") o.topics.right_info = to;
-      else if (from == "velodyne_points") o.topics.cloud = to;
-      else o.outputs.remaps[from] = to;
+      const std::map<std::string, std::string*> inputs = {
+          {"left/image_rect_color", &o.topics.left_image},
+          {"left/camera_info", &o.topics.left_info},
+          {"right/image_rect_color", &o.topics.right_image},
+          {"right/camera_info", &o.topics.right_info},
+          {"velodyne_points", &o.topics.cloud}};
+      const auto input = inputs.find(from);
+      *(input != inputs.end() ? input->second : &o.outputs.remaps[from]) = to;
     } else {
       rest.push_back(argv[i]);
     }
@@ -158,7 +161,8 @@ lsf::NodeParams readNodeParams(const Options& o) {
   if (o.approximate_sync) p.approximate_sync = true;
   if (p.queue_size < 1 || p.sweep_buffer_size < 1 || p.max_time_offset < 0 ||
       p.max_sweep_wait < 0 || p.cloud_stride < 1) {
-    throw std::runtime_error(o.node_params + ": queue_size, sweep_buffer_size, cloud_stride must "
+    throw std::runtime_error(o.node_params +
+                             ": queue_size, sweep_buffer_size, cloud_stride must "
                              "be >= 1 and max_time_offset, max_sweep_wait >= 0");
   }
   return p;
@@ -228,20 +232,24 @@ void Runner::checkTopics() {
   std::string names;
   for (const auto& t : present) names += " " + t;
   const std::vector<std::pair<const char*, std::string>> needed = {
-      {"left/image_rect_color", o_.topics.left_image}, {"left/camera_info", o_.topics.left_info},
-      {"right/image_rect_color", o_.topics.right_image}, {"right/camera_info", o_.topics.right_info},
+      {"left/image_rect_color", o_.topics.left_image},
+      {"left/camera_info", o_.topics.left_info},
+      {"right/image_rect_color", o_.topics.right_image},
+      {"right/camera_info", o_.topics.right_info},
       {"velodyne_points", o_.topics.cloud}};
   std::string missing;
   for (const auto& [name, topic] : needed) {
     if (!present.count(topic)) missing += " " + topic + " (remap with " + name + ":=TOPIC)";
   }
   if (!missing.empty()) {
-    throw std::runtime_error("the recording has no messages on" + missing + "; its topics:" +
-                             (names.empty() ? " none" : names));
+    throw std::runtime_error("the recording has no messages on" + missing +
+                             "; its topics:" + (names.empty() ? " none" : names));
   }
   if (!present.count("/tf_static") && !present.count("/tf")) {
-    throw std::runtime_error("the recording has no /tf_static or /tf: no LiDAR -> camera "
-                             "transform; its topics:" + names);
+    throw std::runtime_error(
+        "the recording has no /tf_static or /tf: no LiDAR -> camera "
+        "transform; its topics:" +
+        names);
   }
   begin_ = all.getBeginTime();
   from_ = o_.start >= 0 ? begin_ + ros::Duration(o_.start) : ros::TIME_MIN;
@@ -298,8 +306,7 @@ void Runner::drain(bool all, lsf::FusionPipeline& pipeline, lsf::OutputWriter& w
   auto& decided = pairing_->decided();
   while (!decided.empty()) {
     lsf::SetOutcome& s = decided.front();
-    if (!all && s.match &&
-        pairing_->now() < s.match->sweep_stamp + ros::Duration(kTfLookahead)) {
+    if (!all && s.match && pairing_->now() < s.match->sweep_stamp + ros::Duration(kTfLookahead)) {
       break;
     }
     const int before = done_;
@@ -330,19 +337,21 @@ int Runner::run() {
   }
   // Read from --lead-in before the range, and on past its end until its last sets are decided.
   const ros::Time read_from =
-      from_ == ros::TIME_MIN ? ros::TIME_MIN
-                             : std::max(begin_, from_ - ros::Duration(std::min(
-                                                            o_.lead_in, (from_ - begin_).toSec())));
+      from_ == ros::TIME_MIN
+          ? ros::TIME_MIN
+          : std::max(begin_, from_ - ros::Duration(std::min(o_.lead_in, (from_ - begin_).toSec())));
   const ros::Time read_to =
       to_ == ros::TIME_MAX
           ? ros::TIME_MAX
           : to_ + ros::Duration(node_params_.max_sweep_wait + node_params_.max_time_offset + 2.0);
   rosbag::View count, view;
-  const std::vector<std::string> inputs = {o_.topics.left_image, o_.topics.left_info,
+  const std::vector<std::string> inputs = {o_.topics.left_image,  o_.topics.left_info,
                                            o_.topics.right_image, o_.topics.right_info,
-                                           o_.topics.cloud, "/tf"};
+                                           o_.topics.cloud,       "/tf"};
   for (const auto& bag : bags_) {
-    count.addQuery(*bag, rosbag::TopicQuery(o_.topics.left_image), from_, to_);
+    // View ends are inclusive; the range is [from_, to_).
+    count.addQuery(*bag, rosbag::TopicQuery(o_.topics.left_image), from_,
+                   to_ == ros::TIME_MAX ? to_ : to_ - ros::Duration(0, 1));
     view.addQuery(*bag, rosbag::TopicQuery(inputs), read_from, read_to);
   }
   const int total = static_cast<int>(count.size());
@@ -360,8 +369,8 @@ int Runner::run() {
       drain(false, pipeline, writer, progress);
     }
   } catch (const std::exception& e) {  // a damaged chunk, a message of the wrong type
-    read_error = "cannot read the recording after bag time " +
-                 lsf::stampName(pairing_->now()) + ": " + e.what();
+    read_error = "cannot read the recording after bag time " + lsf::stampName(pairing_->now()) +
+                 ": " + e.what();
   }
   pairing_->finish();
   drain(true, pipeline, writer, progress);

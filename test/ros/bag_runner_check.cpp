@@ -46,9 +46,9 @@ void expectBagRunnerAgrees(const std::string& bag_path, const std::string& out,
     ASSERT_EQ(png.size(), expected.size());
     EXPECT_EQ(cv::countNonZero(png != expected), 0) << "pixels where bag_runner's PNG differs "
                                                        "from the nodelet's depth";
-    const auto a = agreeWithRunner(
-        kitti::readDepthPng(out + "/" + name),
-        kitti::readDepthPng(runner_out + "/" + frames.at(i) + ".png"), fB);
+    const auto a =
+        agreeWithRunner(kitti::readDepthPng(out + "/" + name),
+                        kitti::readDepthPng(runner_out + "/" + frames.at(i) + ".png"), fB);
     EXPECT_GT(a.both, a.pixels / 2);
     EXPECT_LE(a.validity_differs, a.pixels / 1000);
     EXPECT_LE(a.bad_1px, a.both / 1000);

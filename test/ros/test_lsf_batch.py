@@ -115,6 +115,34 @@ def test_bag_runner_writes_a_named_png_and_row_per_set(bags, serial):
             assert len(nsec) == 9
 
 
+def test_bag_runner_optional_outputs_and_output_bag(bags, serial):
+    import rosbag
+    folder = os.path.join(SCRATCH, "extras")
+    out_bag = os.path.join(SCRATCH, "fused.bag")
+    result = run([BAG_RUNNER, "--bag", bags[0], "--out", folder, "--disparity", "--confidence",
+                  "--cloud", "--out-bag", out_bag])
+    assert result.returncode == 0, result.stderr
+    name = os.path.basename(bags[0])[:-4]
+    stamps = [r[0] for r in rows(serial[name])]
+    depth = {p: b for p, b in pngs(folder).items() if os.sep not in p}
+    assert depth == pngs(serial[name])
+    for sub, ext in (("disparity", ".png"), ("confidence", ".png"), ("cloud", ".pcd")):
+        assert sorted(os.listdir(os.path.join(folder, sub))) == [s + ext for s in stamps], sub
+    with rosbag.Bag(bags[0]) as bag:
+        left = {"%d.%09d" % (m.header.stamp.secs, m.header.stamp.nsecs): t
+                for _, m, t in bag.read_messages(["/stereo/left/image_rect_color"])}
+    with rosbag.Bag(out_bag) as bag:
+        topics = bag.get_type_and_topic_info().topics
+        for topic in ("/fusion/depth/image_rect", "/fusion/depth/camera_info", "/fusion/disparity",
+                      "/fusion/points2", "/fusion/lidar_disparity", "/fusion/confidence"):
+            assert topics[topic].message_count == 2, topic
+        for _, msg, t in bag.read_messages(["/fusion/depth/image_rect"]):
+            stamp = "%d.%09d" % (msg.header.stamp.secs, msg.header.stamp.nsecs)
+            assert stamp in stamps
+            assert t == left[stamp]  # at the input's record time
+            assert msg.encoding == "32FC1" and msg.header.frame_id == "left_camera_optical_frame"
+
+
 def test_batch_of_three_bags_equals_serial_bag_runner(bags, serial):
     out = os.path.join(SCRATCH, "batch")
     result = batch("--out", out, os.path.join(SCRATCH, "drive*.bag"))

@@ -8,8 +8,8 @@
 #include <memory>
 #include <string>
 
-#include <Eigen/Geometry>
 #include <rosbag/bag.h>
+#include <Eigen/Geometry>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
@@ -21,7 +21,7 @@ namespace lidar_stereo_fusion {
 /// One processed set: the core result and what the ROS layer knows of it.
 struct FusedSet {
   StereoCamera camera;
-  cv::Mat left;              ///< left image as the pipeline saw it
+  cv::Mat left;  ///< left image as the pipeline saw it
   FusionResult result;
   cv::Mat1f depth;           ///< the node's published depth [m] (outputDepth), 0 = none
   double conversion_ms = 0;  ///< message -> core types
@@ -39,8 +39,8 @@ FusedSet fuseSet(const InputMatch& match, const Eigen::Isometry3d& T_cam_lidar,
 struct OutputOptions {
   std::string dir;
   bool disparity = false, confidence = false, cloud = false;
-  std::string out_bag;  ///< empty: none
-  std::string ns = "/fusion";  ///< namespace of the --out-bag topics
+  std::string out_bag;                        ///< empty: none
+  std::string ns = "/fusion";                 ///< namespace of the --out-bag topics
   std::map<std::string, std::string> remaps;  ///< output name (relative) -> topic
 };
 

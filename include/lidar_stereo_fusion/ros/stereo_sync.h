@@ -63,9 +63,9 @@ class StereoSync {
   using Image = sensor_msgs::Image;
   using Info = sensor_msgs::CameraInfo;
   /// A complete set, or (drop callback, exact sync only) an incomplete one given up (null parts).
-  using SetCallback =
-      boost::function<void(const sensor_msgs::ImageConstPtr&, const sensor_msgs::CameraInfoConstPtr&,
-                         const sensor_msgs::ImageConstPtr&, const sensor_msgs::CameraInfoConstPtr&)>;
+  using SetCallback = boost::function<void(
+      const sensor_msgs::ImageConstPtr&, const sensor_msgs::CameraInfoConstPtr&,
+      const sensor_msgs::ImageConstPtr&, const sensor_msgs::CameraInfoConstPtr&)>;
 
   /// Connects to the four input filters (left image, left info, right image, right info).
   template <class LeftImage, class LeftInfo, class RightImage, class RightInfo>
