@@ -18,7 +18,6 @@
 #include <rosbag/view.h>
 #include <tf2/exceptions.h>
 #include <tf2_eigen/tf2_eigen.h>
-#include <opencv2/core/persistence.hpp>
 
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
@@ -131,53 +130,24 @@ Options parseOptions(int argc, char** argv) {
   return o;
 }
 
-/// The node parameters bag_runner uses, from a fusion_node.yaml-style file.
+/// The node parameters: --node-params, then --approximate-sync.
 lsf::NodeParams readNodeParams(const Options& o) {
-  lsf::NodeParams p;
-  if (!o.node_params.empty()) {
-    cv::FileStorage fsr;
-    try {
-      fsr.open(o.node_params, cv::FileStorage::READ);
-    } catch (const cv::Exception& e) {
-      throw std::runtime_error("cannot read " + o.node_params + ": " + e.what());
-    }
-    if (!fsr.isOpened()) throw std::runtime_error("cannot read " + o.node_params);
-    const auto number = [&](const char* key, double& v) {
-      if (!fsr[key].empty()) v = static_cast<double>(fsr[key]);
-    };
-    const auto integer = [&](const char* key, int& v) {
-      if (!fsr[key].empty()) v = static_cast<int>(fsr[key]);
-    };
-    const cv::FileNode sync = fsr["approximate_sync"];
-    if (!sync.empty()) p.approximate_sync = sync.isString() ? sync.string() == "true" : int(sync);
-    integer("queue_size", p.queue_size);
-    number("max_time_offset", p.max_time_offset);
-    number("max_sweep_wait", p.max_sweep_wait);
-    integer("sweep_buffer_size", p.sweep_buffer_size);
-    integer("num_rings", p.num_rings);
-    number("max_output_depth", p.max_output_depth);
-    integer("cloud_stride", p.cloud_stride);
-  }
+  lsf::NodeParams p =
+      o.node_params.empty() ? lsf::NodeParams() : lsf::readNodeParamsYaml(o.node_params);
   if (o.approximate_sync) p.approximate_sync = true;
-  if (p.queue_size < 1 || p.sweep_buffer_size < 1 || p.max_time_offset < 0 ||
-      p.max_sweep_wait < 0 || p.cloud_stride < 1) {
-    throw std::runtime_error(o.node_params +
-                             ": queue_size, sweep_buffer_size, cloud_stride must "
-                             "be >= 1 and max_time_offset, max_sweep_wait >= 0");
-  }
   return p;
 }
 
-/// Rows of an earlier run (frames.csv) by stamp, for --resume.
+/// The ok rows of an earlier run (frames.csv, or the rows written before it was killed) by stamp,
+/// for --resume.
 std::map<std::string, std::string> earlierRows(const std::vector<std::string>& files) {
   std::map<std::string, std::string> rows;
   for (const auto& file : files) {
     std::ifstream in(file);
     std::string line;
-    std::getline(in, line);  // header
     while (std::getline(in, line)) {
       const std::string stamp = line.substr(0, line.find(','));
-      if (line.find(",ok,") != std::string::npos) rows.emplace(stamp, line + "\n");
+      if (line.compare(stamp.size(), 4, ",ok,") == 0) rows.emplace(stamp, line + "\n");
     }
   }
   return rows;
@@ -221,6 +191,7 @@ class Runner {
   std::map<ros::Time, std::string> rows_;
   std::map<std::string, std::string> earlier_;
   std::vector<std::string> failed_;
+  std::ofstream partial_;  ///< the ok rows so far (frames.csv.partial), for a resumed run
   int done_ = 0, ok_ = 0, skipped_ = 0;
 };
 
@@ -290,6 +261,7 @@ void Runner::finishSet(lsf::SetOutcome& s, lsf::FusionPipeline& pipeline,
     const lsf::FusedSet set = lsf::fuseSet(match, T, pipeline, node_params_);
     writer.write(match, s.receipt, set, params_);
     rows_[s.stamp] = lsf::okRow(s.stamp, match, set, lsf::methodName(params_.method));
+    partial_ << rows_[s.stamp] << std::flush;  // for --resume after a kill
     ++ok_;
     return;
   } catch (const std::exception& e) {
@@ -325,9 +297,12 @@ void Runner::writeRows() const {
 int Runner::run() {
   checkTopics();
   fs::create_directories(o_.outputs.dir);
+  const std::string partial = o_.frames_csv + ".partial";
   if (o_.resume) {
-    earlier_ = earlierRows({o_.frames_csv, (fs::path(o_.outputs.dir) / "frames.csv").string()});
+    earlier_ =
+        earlierRows({partial, o_.frames_csv, (fs::path(o_.outputs.dir) / "frames.csv").string()});
   }
+  partial_.open(partial, std::ios::app);
   pairing_ = std::make_unique<lsf::BagPairing>(node_params_, o_.topics);
   {
     // /tf_static of the whole recording: recorded once at its start, needed by every time range.
@@ -377,6 +352,8 @@ int Runner::run() {
   progress.finish();
   writer.close();
   writeRows();
+  partial_.close();
+  fs::remove(partial);
 
   std::cout << "bag_runner: " << done_ << " image sets: " << ok_ << " ok, " << skipped_
             << " skipped, " << failed_.size() << " failed; wrote " << o_.frames_csv << "\n";

@@ -283,3 +283,25 @@ def test_zed_velodyne_topics_with_late_sweeps(bags, serial):
     result = batch("--out", out, zed, *batch_bags.ZED_REMAPS)
     assert result.returncode == 0, result.stderr
     assert pngs(os.path.join(out, "zed_rig")) == pngs(serial[name])
+
+
+def test_node_params_file_and_approximate_sync(bags):
+    source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+    outputs = []
+    for i, extra in enumerate(([], ["--node-params", os.path.join(source, "config",
+                                                                    "fusion_node.yaml")],
+                               ["--approximate-sync"])):
+        folder = os.path.join(SCRATCH, "node_params%d" % i)
+        result = run([BAG_RUNNER, "--bag", bags[1], "--out", folder, "--method", "lidar_bi"] +
+                     extra)
+        assert result.returncode == 0, result.stderr
+        outputs.append(pngs(folder))
+    assert len(outputs[0]) == 2
+    assert outputs[1] == outputs[0] and outputs[2] == outputs[0]
+    bad = os.path.join(SCRATCH, "bad_node_params.yaml")
+    with open(bad, "w") as f:
+        f.write("approximate_sync: maybe\n")
+    result = run([BAG_RUNNER, "--bag", bags[1], "--out", os.path.join(SCRATCH, "bad_np"),
+                  "--node-params", bad])
+    assert result.returncode == 1
+    assert bad + ": approximate_sync must be true or false" in result.stderr
