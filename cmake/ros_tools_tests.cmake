@@ -88,11 +88,7 @@ endif()
 
 # bag_runner and lsf_batch on small KITTI bags (pytest; lsf_batch on a LocalCluster of 2 worker
 # processes): batch == serial, a killed worker, chunks, resume, bad bags, other rigs' topics.
+# run_tests.py runs the command as one shell string (as catkin_add_nosetests does).
 catkin_run_tests_target("pytest" "lsf_batch" "pytest-lsf_batch.xml"
-  COMMAND ${CMAKE_COMMAND} -E env LSF_DATA_DIR=${LSF_DATA_DIR}
-    LSF_BIN_DIR=$<TARGET_FILE_DIR:bag_runner>
-    LSF_SCRATCH=${CMAKE_CURRENT_BINARY_DIR}/test_lsf_batch
-    ${PYTHON_EXECUTABLE} -m pytest -q -p no:cacheprovider
-    --junitxml=${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-lsf_batch.xml
-    ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_lsf_batch.py
+  COMMAND "${CMAKE_COMMAND} -E env LSF_DATA_DIR=${LSF_DATA_DIR} LSF_BIN_DIR=$<TARGET_FILE_DIR:bag_runner> LSF_SCRATCH=${CMAKE_CURRENT_BINARY_DIR}/test_lsf_batch ${PYTHON_EXECUTABLE} -m pytest -q -p no:cacheprovider --junitxml=${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-lsf_batch.xml ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_lsf_batch.py"
   DEPENDENCIES bag_runner kitti_to_bag)
