@@ -15,6 +15,7 @@ add_library(${PROJECT_NAME}_ros
   src/ros/ego_motion.cpp
   src/ros/ros_params.cpp
   src/ros/node_support.cpp
+  src/ros/stereo_sync.cpp
   src/ros/input_gate.cpp
   src/ros/input_watch.cpp
   src/ros/output_publisher.cpp

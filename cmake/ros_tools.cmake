@@ -4,6 +4,8 @@
 #   autoware_calibration_publisher  static TF lidar -> camera (+ camera_info) from Autoware YAML
 #   kitti_calibration_publisher     static TF velodyne -> left -> right camera from KITTI calib
 #   kitti_to_bag                    KITTI raw drive -> ROS 1 bag with the rig's topics
+#   bag_runner                      the fusion on every image set of recorded bags (no roscore)
+#   lsf_batch                       bag_runner over archives of bags on Dask distributed (Python)
 
 # ROS messages built from the ROS-free calibration readers (and the KITTI oxts ego-motion as TF);
 # shared by the tools and their tests.
@@ -26,6 +28,14 @@ foreach(tool ${LSF_ROS_TOOLS})
 endforeach()
 # The sweep message: conversions::cloudToMsg, the fields of velodyne_pointcloud.
 target_link_libraries(kitti_to_bag ${PROJECT_NAME}_ros)
+
+# bag_runner: the node's pairing (stereo_sync.h) fed from bags; its parts in a library for tests.
+add_library(${PROJECT_NAME}_bag STATIC src/ros/bag_pairing.cpp src/ros/bag_outputs.cpp)
+target_link_libraries(${PROJECT_NAME}_bag PUBLIC ${PROJECT_NAME}_ros)
+add_executable(bag_runner src/ros/bag_runner.cpp)
+target_link_libraries(bag_runner ${PROJECT_NAME}_bag)
+list(APPEND LSF_ROS_TOOLS bag_runner)
+catkin_install_python(PROGRAMS scripts/lsf_batch DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 install(TARGETS ${LSF_ROS_TOOLS} RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 install(FILES launch/calibration_autoware.launch launch/calibration_kitti.launch

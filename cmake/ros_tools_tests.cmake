@@ -51,11 +51,13 @@ target_compile_definitions(test_calibration_publishers PRIVATE
 if(TARGET kitti_runner)
   lsf_add_tools_rostest(test_kitti_bag test/ros/kitti_bag.test
     SOURCES test/ros/test_kitti_bag.cpp test/ros/kitti_bag_expected.cpp test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
-    DEPENDS kitti_to_bag kitti_runner ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
+            test/ros/depth_agreement.cpp test/ros/bag_runner_check.cpp
+    DEPENDS kitti_to_bag kitti_runner bag_runner ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
   target_include_directories(test_kitti_bag SYSTEM PRIVATE
     ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})  # FusionStats.h
   target_compile_definitions(test_kitti_bag PRIVATE
-    LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>" LSF_KITTI_RUNNER="$<TARGET_FILE:kitti_runner>")
+    LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>" LSF_KITTI_RUNNER="$<TARGET_FILE:kitti_runner>"
+    LSF_BAG_RUNNER="$<TARGET_FILE:bag_runner>")
   lsf_add_tools_rostest(test_kitti_bag_rates test/ros/kitti_bag_rates.test
     SOURCES test/ros/test_kitti_bag_rates.cpp test/ros/kitti_bag_expected.cpp
             test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
@@ -92,3 +94,10 @@ else()
   message(WARNING "no kitti_runner target (tools/kitti_runner.cpp): test/ros/kitti_bag.test is "
                   "not registered")
 endif()
+
+# bag_runner and lsf_batch on small KITTI bags (pytest; lsf_batch on a LocalCluster of 2 worker
+# processes): batch == serial, a killed worker, chunks, resume, bad bags, other rigs' topics.
+# run_tests.py runs the command as one shell string (as catkin_add_nosetests does).
+catkin_run_tests_target("pytest" "lsf_batch" "pytest-lsf_batch.xml"
+  COMMAND "${CMAKE_COMMAND} -E env LSF_DATA_DIR=${LSF_DATA_DIR} LSF_BIN_DIR=$<TARGET_FILE_DIR:bag_runner> LSF_SCRATCH=${CMAKE_CURRENT_BINARY_DIR}/test_lsf_batch ${PYTHON_EXECUTABLE} -m pytest -q -p no:cacheprovider --junitxml=${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-lsf_batch.xml ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_lsf_batch.py"
+  DEPENDENCIES bag_runner kitti_to_bag)

@@ -18,6 +18,7 @@ PKGS=(
   python3-roslaunch ros-message-generation ros-message-runtime
   xvfb imagemagick rviz rosbash python3-sensor-msgs python3-stereo-msgs
   clang libclang-rt-14-dev libomp-dev
+  python3-distributed python3-dask python3-psutil python3-pytest
 )
 
 missing=()

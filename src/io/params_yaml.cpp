@@ -173,20 +173,6 @@ std::string withYamlDirective(const std::string& text) {
   return "%YAML:1.0\n---\n" + text;
 }
 
-cv::FileStorage openYaml(const std::string& path) {
-  const std::string raw = readTextFile(path, "params YAML");
-  requireTextFile(raw, path, "params YAML");
-  requireYamlMarkersAlone(raw, path, "params YAML");
-  const std::string text = withYamlDirective(raw);
-  cv::FileStorage fs;
-  try {
-    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error("params YAML " + path + ": not valid YAML (" + e.what() + ")");
-  }
-  if (!fs.isOpened()) throw std::runtime_error("params YAML " + path + ": not valid YAML");
-  return fs;
-}
 
 // ---- Writing --------------------------------------------------------------------------------
 
@@ -213,6 +199,21 @@ class FieldWriter {
 };
 
 }  // namespace
+
+cv::FileStorage openYaml(const std::string& path) {
+  const std::string raw = readTextFile(path, "params YAML");
+  requireTextFile(raw, path, "params YAML");
+  requireYamlMarkersAlone(raw, path, "params YAML");
+  const std::string text = withYamlDirective(raw);
+  cv::FileStorage fs;
+  try {
+    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error("params YAML " + path + ": not valid YAML (" + e.what() + ")");
+  }
+  if (!fs.isOpened()) throw std::runtime_error("params YAML " + path + ": not valid YAML");
+  return fs;
+}
 
 void loadParamsYaml(const std::string& path, FusionParams& params) {
   cv::FileStorage fs = openYaml(path);

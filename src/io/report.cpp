@@ -130,6 +130,10 @@ void ProgressBar::update(int done, const std::string& note) {
   std::string line =
       "[" + bar + "] " + std::to_string(clamped) + "/" + std::to_string(total_) + " " + note;
   if (clamped > 0) line += "  " + format("%.2f", elapsed / clamped) + " s/frame";
+  // The time left at the mean rate so far.
+  if (clamped > 0 && clamped < total_) {
+    line += ", ETA " + format("%.0f", elapsed / clamped * (total_ - clamped)) + " s";
+  }
   if (interactive_) {
     out_ << "\r" << line << "\033[K" << std::flush;  // \033[K clears the rest of the line
     open_line_ = true;

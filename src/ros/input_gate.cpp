@@ -9,61 +9,6 @@
 
 namespace lidar_stereo_fusion {
 
-namespace {
-
-std::string sizeText(uint32_t width, uint32_t height) {
-  return std::to_string(width) + "x" + std::to_string(height);
-}
-
-}  // namespace
-
-boost::optional<Rejection> checkImageSet(const ImageSet& set) {
-  std::string problem = conversions::checkImage(*set.left);
-  if (!problem.empty()) return Rejection{kLeftImage, "image", problem};
-  problem = conversions::checkImage(*set.right);
-  if (!problem.empty()) return Rejection{kRightImage, "image", problem};
-  if (set.left->width != set.right->width || set.left->height != set.right->height) {
-    return Rejection{kRightImage, "size",
-                     "size " + sizeText(set.right->width, set.right->height) +
-                         " differs from the left image's " +
-                         sizeText(set.left->width, set.left->height)};
-  }
-  if (set.left_info->width != set.left->width || set.left_info->height != set.left->height) {
-    return Rejection{kLeftInfo, "size",
-                     "camera_info is " + sizeText(set.left_info->width, set.left_info->height) +
-                         " but the image is " + sizeText(set.left->width, set.left->height)};
-  }
-  if (set.right_info->width != set.right->width || set.right_info->height != set.right->height) {
-    return Rejection{kRightInfo, "size",
-                     "camera_info is " + sizeText(set.right_info->width, set.right_info->height) +
-                         " but the image is " + sizeText(set.right->width, set.right->height)};
-  }
-  try {
-    conversions::stereoCameraFromInfo(*set.left_info, *set.right_info);
-  } catch (const conversions::CameraInfoError& e) {
-    return Rejection{e.left ? kLeftInfo : kRightInfo, "calibration", e.what()};
-  }
-  if (set.left->header.frame_id.empty()) {
-    return Rejection{kLeftImage, "frame_id",
-                     "empty frame_id (the left optical frame is needed for TF)"};
-  }
-  return boost::none;
-}
-
-boost::optional<Rejection> checkCloud(const sensor_msgs::PointCloud2& cloud) {
-  // Field types first, as their own kind of problem: a cloud of the wrong types is not a damaged
-  // one, and its warning must not be throttled away by another layout problem's.
-  const std::string types = conversions::checkCloudFieldTypes(cloud);
-  if (!types.empty()) return Rejection{kCloud, "field type", types};
-  const std::string problem = conversions::checkCloudLayout(cloud);
-  if (!problem.empty()) return Rejection{kCloud, "layout", problem};
-  if (cloud.width == 0 || cloud.height == 0) {
-    return Rejection{kCloud, "empty", "empty cloud (0 points)"};
-  }
-  if (cloud.header.frame_id.empty()) return Rejection{kCloud, "frame_id", "empty frame_id"};
-  return boost::none;
-}
-
 bool RateLimiter::accept(const ros::Time& stamp) {
   if (max_rate_ <= 0.0) return true;
   // Less 10 % of the period for stamp jitter: 10 Hz input at max_rate 5 gives 5 Hz, not 3.3.
@@ -85,32 +30,18 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
              params.input_timeout, log),
       rate_(params.max_rate),
       fresh_(params.fresh_wait) {
-  InputMatcher::Params mp;
-  mp.max_time_offset = params_.max_time_offset;
-  mp.max_wait = params_.max_sweep_wait;
-  mp.sweep_buffer_size = static_cast<std::size_t>(params_.sweep_buffer_size);
-  matcher_.setParams(mp);
+  matcher_.setParams(matcherParams(params_));
 
   // Synchroniser of the image set (connected once; the filters are (un)subscribed lazily).
+  it_ = std::make_shared<image_transport::ImageTransport>(nh_);
   using boost::placeholders::_1;
   using boost::placeholders::_2;
   using boost::placeholders::_3;
   using boost::placeholders::_4;
-  it_ = std::make_shared<image_transport::ImageTransport>(nh_);
-  if (params_.approximate_sync) {
-    approx_sync_ = std::make_shared<message_filters::Synchronizer<ApproxPolicy>>(
-        ApproxPolicy(params_.queue_size), sub_left_image_, sub_left_info_, sub_right_image_,
-        sub_right_info_);
-    approx_sync_->setReset(true);  // clears its queues when simulated time jumps back
-    approx_sync_->registerCallback(boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4));
-  } else {
-    exact_sync_ = std::make_shared<message_filters::Synchronizer<ExactPolicy>>(
-        ExactPolicy(params_.queue_size), sub_left_image_, sub_left_info_, sub_right_image_,
-        sub_right_info_);
-    exact_sync_->setReset(true);
-    exact_sync_->registerCallback(boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4));
-    exact_sync_->registerDropCallback(boost::bind(&InputGate::syncDropCb, this, _1, _2, _3, _4));
-  }
+  sync_ = std::make_unique<StereoSync>(
+      params_, sub_left_image_, sub_left_info_, sub_right_image_, sub_right_info_,
+      boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4),
+      boost::bind(&InputGate::syncDropCb, this, _1, _2, _3, _4));
   // Every input topic's arrivals, for the watch (indices as in watch_'s list); the cloud's in
   // cloudCb.
   sub_left_image_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(

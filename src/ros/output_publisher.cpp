@@ -124,6 +124,18 @@ void OutputPublisher::shutdown() {
   if (gate_.subscribed()) gate_.unsubscribe();
 }
 
+cv::Mat1f outputDepth(const FusionResult& result, const StereoCamera& camera,
+                      double max_output_depth) {
+  cv::Mat1f depth = result.depth;
+  if (depth.empty() && !result.disparity.empty())
+    depth = disparityToDepth(result.disparity, camera);
+  if (max_output_depth > 0.0) {
+    depth = depth.clone();
+    depth.setTo(0.f, depth > max_output_depth);
+  }
+  return depth;
+}
+
 void OutputPublisher::connectCb() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (shut_down_) return;
@@ -145,9 +157,9 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
                               const FusionParams& params, const FrameReport& report) {
   const auto out_start = std::chrono::steady_clock::now();
   const std_msgs::Header& header = match.images.left->header;
-  cv::Mat1f depth = result.depth;
-  if (depth.empty() && !result.disparity.empty())
-    depth = disparityToDepth(result.disparity, camera);
+  // One depth range for depth/image_rect and points2: the pipeline's (projection max_depth),
+  // clipped further by ~max_output_depth.
+  const cv::Mat1f depth = outputDepth(result, camera, params_.max_output_depth);
 
   stereo_msgs::DisparityImagePtr disparity_msg;
   sensor_msgs::ImagePtr depth_msg, depth_color_msg, prior_msg, disparity_image_msg,
@@ -180,12 +192,6 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
     const double max = std::min(params.patchmatch.max_disparity, top);
     disparity_color_msg = conversions::bgrImageToMsg(
         withColorBar(colorizeDisparity(result.disparity, max), 0.0, max, "px"), header);
-  }
-  // One depth range for depth/image_rect and points2: the pipeline's (projection max_depth),
-  // clipped further by ~max_output_depth.
-  if (params_.max_output_depth > 0.0) {
-    depth = depth.clone();
-    depth.setTo(0.f, depth > params_.max_output_depth);
   }
   if (pub_depth_.getNumSubscribers() > 0) {
     depth_msg = conversions::depthToMsg(depth, header);

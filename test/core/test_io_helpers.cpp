@@ -228,6 +228,9 @@ TEST(Report, TablesMedianAndProgress) {
   ProgressBar bar(out, 4, false, 8);
   bar.update(2, "frame");
   EXPECT_EQ(out.str().substr(0, 22), "[====>   ] 2/4 frame  ");
+  EXPECT_NE(out.str().find(" s/frame, ETA "), std::string::npos) << out.str();
+  bar.update(4, "done");  // nothing left: no ETA
+  EXPECT_EQ(out.str().find("ETA", out.str().find("4/4")), std::string::npos) << out.str();
 }
 
 TEST(CommandLine, OptionsFlagsAndErrors) {

@@ -41,6 +41,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "data/data_guard.h"
+#include "bag_runner_check.h"
+#include "depth_agreement.h"
 #include "kitti_bag_expected.h"
 #include "kitti_bag_util.h"
 #include "lidar_stereo_fusion/FusionStats.h"
@@ -437,6 +439,7 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
   const double baseline =
       -topics["/stereo/right/camera_info"].front().instantiate<sensor_msgs::CameraInfo>()->P[3] /
       fx;
+  std::vector<cv::Mat1f> nodelet_depths;
   for (size_t i = 0; i < stamps.size(); ++i) {
     const ros::Time& t = stamps[i];
     SCOPED_TRACE("frame " + kReplayFrames[i]);
@@ -499,35 +502,20 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
     // nodelet's depth as the PNG does (metres * 256 to an integer, clamped to 65535).
     const cv::Mat1f z_runner = kitti::readDepthPng(runner_out + "/" + kReplayFrames[i] + ".png");
     ASSERT_EQ(z_runner.size(), z_ros.size());
-    int both = 0, validity_differs = 0, bad_1px = 0, disparity_off = 0;
-    double sum_abs = 0;
+    int disparity_off = 0;
     for (int y = 0; y < z_ros.rows; ++y) {
       for (int x = 0; x < z_ros.cols; ++x) {
-        const float z = z_ros(y, x), zr = z_runner(y, x);
-        const bool has_ros = std::isfinite(z) && z > 0, has_runner = zr > 0;
         // Depth and disparity outputs agree: z = f B / d.
-        if (has_ros && !(std::abs(z - fx * baseline / d_ros(y, x)) <= 1e-4 * z)) ++disparity_off;
-        if (has_ros != has_runner) ++validity_differs;
-        if (!has_ros || !has_runner) continue;
-        ++both;
-        const double z_png = std::clamp(std::round(z * 256.0), 1.0, 65535.0) / 256.0;
-        const double diff = std::abs(fx * baseline / z_png - fx * baseline / zr);
-        if (diff > 1.0) {
-          ++bad_1px;
-        } else {
-          sum_abs += diff;
-        }
+        const float z = z_ros(y, x);
+        if (std::isfinite(z) && z > 0 && !(std::abs(z - fx * baseline / d_ros(y, x)) <= 1e-4 * z))
+          ++disparity_off;
       }
     }
-    const int pixels = z_ros.rows * z_ros.cols;
-    // Mean over the pixels that agree within 1 px.
-    const double mean_abs = both > bad_1px ? sum_abs / (both - bad_1px) : 0.0;
-    std::printf(
-        "frame %s: %d px with depth (%.1f %%); nodelet vs core: %d px differ; nodelet vs "
-        "runner: validity differs on %d px, disparity off by > 1 px on %d px (%.4f %%), "
-        "mean |diff| of the others %.5f px\n",
-        kReplayFrames[i].c_str(), both, 100.0 * both / pixels, differ_core, validity_differs,
-        bad_1px, 100.0 * bad_1px / std::max(both, 1), mean_abs);
+    const auto agreement = lidar_stereo_fusion::test::agreeWithRunner(z_ros, z_runner, fx * baseline);
+    const int pixels = agreement.pixels, both = agreement.both;
+    const int validity_differs = agreement.validity_differs, bad_1px = agreement.bad_1px;
+    const double mean_abs = agreement.mean_abs;
+    nodelet_depths.push_back(z_ros.clone());
     EXPECT_EQ(disparity_off, 0);
     EXPECT_GT(both, pixels / 2);
     EXPECT_LE(validity_differs, pixels / 1000);  // 0.1 %
@@ -535,6 +523,9 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
     EXPECT_LT(mean_abs, 0.01);                   // [px]
   }
   bag.close();
+  lidar_stereo_fusion::test::expectBagRunnerAgrees(bag_path, scratchDir() + "/bag_runner", stamps,
+                                                  kReplayFrames, nodelet_depths, runner_out,
+                                                  fx * baseline);
 }
 
 int main(int argc, char** argv) {

@@ -10,6 +10,8 @@
 
 #include <string>
 
+#include <opencv2/core/persistence.hpp>
+
 #include "lidar_stereo_fusion/core/pipeline.h"
 
 namespace lidar_stereo_fusion {
@@ -17,6 +19,11 @@ namespace lidar_stereo_fusion {
 /// Overrides the fields of `params` named in the YAML file and validates the result.
 /// Throws std::runtime_error naming the file and the offending key or value.
 void loadParamsYaml(const std::string& path, FusionParams& params);
+
+/// Opens a YAML file (rosparam style, no "%YAML" directive needed) for reading with OpenCV's
+/// FileStorage, after the checks of loadParamsYaml (text, document markers). Throws
+/// std::runtime_error naming the file.
+cv::FileStorage openYaml(const std::string& path);
 
 /// Writes every field (the effective configuration) as YAML to `path`.
 void saveParamsYaml(const std::string& path, const FusionParams& params);

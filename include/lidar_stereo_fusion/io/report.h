@@ -50,7 +50,8 @@ std::string formatTimingSummary(const std::vector<FrameStats>& stats);
 class ProgressBar {
  public:
   ProgressBar(std::ostream& out, int total, bool interactive, int width = 30);
-  /// Shows `done` of `total` finished, with `note` (e.g. the current frame) after the bar.
+  /// Shows `done` of `total` finished, with `note` (e.g. the current frame) after the bar, the
+  /// seconds per item so far and the estimated time left.
   void update(int done, const std::string& note);
   /// Ends the line (interactive mode).
   void finish();

@@ -19,9 +19,6 @@
 #include <image_transport/image_transport.h>
 #include <image_transport/subscriber_filter.h>
 #include <message_filters/subscriber.h>
-#include <message_filters/sync_policies/approximate_time.h>
-#include <message_filters/sync_policies/exact_time.h>
-#include <message_filters/synchronizer.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -32,31 +29,9 @@
 #include "lidar_stereo_fusion/ros/fresh_wait.h"
 #include "lidar_stereo_fusion/ros/input_watch.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
+#include "lidar_stereo_fusion/ros/stereo_sync.h"
 
 namespace lidar_stereo_fusion {
-
-/// A synchronised stereo pair with its camera_infos, as it arrived.
-struct ImageSet {
-  sensor_msgs::ImageConstPtr left, right;
-  sensor_msgs::CameraInfoConstPtr left_info, right_info;
-  ros::Time arrival_ros;                               ///< ROS time when the set was complete
-  std::chrono::steady_clock::time_point arrival_wall;  ///< the same in wall time
-  uint32_t clock_epoch = 0;                            ///< InputGate::clockEpoch() at arrival
-};
-using InputMatcher = FrameMatcher<ImageSet, sensor_msgs::PointCloud2ConstPtr>;
-using InputMatch = InputMatcher::Match;
-
-/// Why a message was refused: the input topic (relative), a fixed word for the kind of problem
-/// (the throttle key) and the problem itself.
-struct Rejection {
-  std::string topic, kind, problem;
-};
-
-/// Checks of an image set that need no state: encodings, sizes, camera_infos against the images,
-/// a usable (and plausible) calibration, a frame_id. Pure; none when the set is usable.
-boost::optional<Rejection> checkImageSet(const ImageSet& set);
-/// Checks of a sweep: layout (conversions::checkCloudLayout), not empty, a frame_id.
-boost::optional<Rejection> checkCloud(const sensor_msgs::PointCloud2& cloud);
 
 /// ~max_rate: accepts a stamp when it is at least 0.9 / max_rate after the last accepted one (or
 /// before it: time went back, the matcher decides). max_rate 0 accepts everything. Not locked.
@@ -99,8 +74,6 @@ class InputGate {
  private:
   using Image = sensor_msgs::Image;
   using Info = sensor_msgs::CameraInfo;
-  using ExactPolicy = message_filters::sync_policies::ExactTime<Image, Info, Image, Info>;
-  using ApproxPolicy = message_filters::sync_policies::ApproximateTime<Image, Info, Image, Info>;
 
   void imageCb(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::CameraInfoConstPtr& li,
                const sensor_msgs::ImageConstPtr& right, const sensor_msgs::CameraInfoConstPtr& ri);
@@ -132,8 +105,7 @@ class InputGate {
   std::shared_ptr<image_transport::ImageTransport> it_;
   image_transport::SubscriberFilter sub_left_image_, sub_right_image_;
   message_filters::Subscriber<Info> sub_left_info_, sub_right_info_;
-  std::shared_ptr<message_filters::Synchronizer<ExactPolicy>> exact_sync_;
-  std::shared_ptr<message_filters::Synchronizer<ApproxPolicy>> approx_sync_;
+  std::unique_ptr<StereoSync> sync_;  ///< the image-set synchroniser (shared with bag_runner)
   ros::Subscriber sub_cloud_;
   std::atomic<bool> subscribed_{false};
   InputWatch watch_;  ///< names silent inputs (its own lock)

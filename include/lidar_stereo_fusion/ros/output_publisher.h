@@ -61,6 +61,12 @@ FusionStatsPtr makeStatsMsg(const std_msgs::Header& header, const FrameStats& st
                             double latency_ms, double sweep_time_offset,
                             const CounterSnapshot& counters);
 
+/// The depth [m] the node publishes (depth/image_rect, points2; 0 = none) for a core result: the
+/// pipeline's, or its disparity's, with depths beyond `max_output_depth` [m] (> 0) emptied.
+/// Shared with bag_runner.
+cv::Mat1f outputDepth(const FusionResult& result, const StereoCamera& camera,
+                      double max_output_depth);
+
 class OutputPublisher {
  public:
   OutputPublisher(const ros::NodeHandle& nh, const ros::NodeHandle& pnh, const std::string& name,

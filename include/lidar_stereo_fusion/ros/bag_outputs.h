@@ -1,0 +1,75 @@
+// What bag_runner writes for one processed image set: the fusion of a matched set (the node's
+// conversions, ring recovery and the core pipeline), the depth PNG and the optional files, the
+// row of frames.csv and the messages of --out-bag. Separate from the bag reading (bag_runner.cpp)
+// so that each stays short.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include <rosbag/bag.h>
+#include <Eigen/Geometry>
+
+#include "lidar_stereo_fusion/core/lidar_projection.h"
+#include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/ros/bag_pairing.h"
+#include "lidar_stereo_fusion/ros/node_support.h"
+
+namespace lidar_stereo_fusion {
+
+/// One processed set: the core result and what the ROS layer knows of it.
+struct FusedSet {
+  StereoCamera camera;
+  cv::Mat left;  ///< left image as the pipeline saw it
+  FusionResult result;
+  cv::Mat1f depth;           ///< the node's published depth [m] (outputDepth), 0 = none
+  double conversion_ms = 0;  ///< message -> core types
+  RingRecovery rings;
+  int cloud_points = 0, invalid_points = 0;
+};
+
+/// Runs the fusion on a matched set with LiDAR -> camera `T_cam_lidar`, exactly as the node's
+/// worker does. Throws std::runtime_error naming the problem (conversion, no finite point,
+/// pipeline failure).
+FusedSet fuseSet(const InputMatch& match, const Eigen::Isometry3d& T_cam_lidar,
+                 FusionPipeline& pipeline, const NodeParams& node_params);
+
+/// Which files to write besides the depth PNG.
+struct OutputOptions {
+  std::string dir;
+  bool disparity = false, confidence = false, cloud = false;
+  std::string out_bag;                        ///< empty: none
+  std::string ns = "/fusion";                 ///< namespace of the --out-bag topics
+  std::map<std::string, std::string> remaps;  ///< output name (relative) -> topic
+};
+
+/// frames.csv: the header line and the rows.
+std::string framesCsvHeader();
+std::string okRow(const ros::Time& stamp, const InputMatch& match, const FusedSet& set,
+                  const std::string& method);
+std::string notOkRow(const ros::Time& stamp, const std::string& status, const std::string& reason);
+
+/// Writes the files of one set (each to a temporary name, then renamed: a killed run leaves no
+/// half-written file) and, with --out-bag, its messages.
+class OutputWriter {
+ public:
+  OutputWriter(const OutputOptions& options, const NodeParams& node_params);
+  ~OutputWriter();
+  /// DIR/<stamp>.png: the depth PNG of the set stamped `stamp`.
+  std::string depthPath(const ros::Time& stamp) const;
+  void write(const InputMatch& match, const ros::Time& receipt, const FusedSet& set,
+             const FusionParams& params);
+  void close();
+
+ private:
+  std::string topic(const std::string& relative) const;
+  OutputOptions options_;
+  NodeParams node_params_;
+  std::unique_ptr<rosbag::Bag> bag_;
+};
+
+/// Writes `text` to `path` through a temporary file and a rename. Throws naming the path.
+void writeFileAtomically(const std::string& path, const std::string& text);
+
+}  // namespace lidar_stereo_fusion
