@@ -54,7 +54,10 @@ add_rostest(test/ros/fusion_max_rate.test DEPENDENCIES test_fusion_node)
 
 # Issue 23: a moving rig's bag (ego-motion on /tf) through the nodelet with and without
 # ~fixed_frame, scored against the exact depth at the image instant.
-lsf_add_ros_test_node(test_moving_rig test/ros/test_moving_rig.cpp test/ros/child_process.cpp)
+lsf_add_ros_test_node(test_moving_rig test/ros/test_moving_rig.cpp test/ros/child_process.cpp
+  test/ros/run_command.cpp)
+target_compile_definitions(test_moving_rig PRIVATE LSF_BAG_RUNNER="$<TARGET_FILE:bag_runner>")
+add_dependencies(test_moving_rig bag_runner)
 add_rostest(test/ros/moving_rig.test DEPENDENCIES test_moving_rig)
 
 # Issue 10: depth_image_proc / stereo_image_proc consume the outputs by remapping only; dynparam

@@ -9,12 +9,15 @@
 #include <filesystem>
 #include <fstream>
 
+#include <tf2/exceptions.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "lidar_stereo_fusion/core/depth.h"
+#include "lidar_stereo_fusion/core/motion_compensation.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/pcd.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
+#include "lidar_stereo_fusion/ros/ego_motion.h"
 #include "lidar_stereo_fusion/ros/output_publisher.h"
 
 namespace fs = std::filesystem;
@@ -70,7 +73,8 @@ cv::Mat scaledUint16(const cv::Mat1f& image, double scale) {
 }  // namespace
 
 FusedSet fuseSet(const InputMatch& match, const Eigen::Isometry3d& T_cam_lidar,
-                 FusionPipeline& pipeline, const NodeParams& node_params) {
+                 FusionPipeline& pipeline, const NodeParams& node_params,
+                 const tf2::BufferCore& tf) {
   // As FusionWorker::processMatch: the same conversions, ring recovery and pipeline.
   const ImageSet& images = match.images;
   FusedSet out;
@@ -81,7 +85,7 @@ FusedSet fuseSet(const InputMatch& match, const Eigen::Isometry3d& T_cam_lidar,
   try {
     conversions::stereoPairToCore(images.left, images.right, input.left, input.right);
     input.camera = conversions::stereoCameraFromInfo(*images.left_info, *images.right_info);
-    cloud = conversions::cloudFromMsg(*match.sweep);
+    cloud = conversions::cloudFromMsg(*match.sweep, node_params.max_point_time);
   } catch (const std::exception& e) {
     throw std::runtime_error(std::string("cannot convert the input set: ") + e.what());
   }
@@ -91,6 +95,22 @@ FusedSet fuseSet(const InputMatch& match, const Eigen::Isometry3d& T_cam_lidar,
                              " is finite and within 10 km");
   }
   out.rings = ensureRings(cloud.cloud, cloud.has_ring, node_params.num_rings);
+  if (!node_params.fixed_frame.empty()) {  // as FusionWorker::compensateEgoMotion
+    try {
+      compensateMotion(cloud.cloud,
+                       sweepMotionFromTf(tf, match.sweep->header.frame_id, node_params.fixed_frame,
+                                         match.sweep_stamp, match.image_stamp,
+                                         motionSampleTimes(cloud.cloud, cloud.has_time,
+                                                           node_params.motion_samples)));
+      removePointsHiddenBeside(cloud.cloud, input.T_cam_lidar, input.camera);
+      out.motion_compensated = true;
+    } catch (const tf2::TransformException& e) {
+      if (node_params.motion_failure == "skip") {
+        throw std::runtime_error(std::string(e.what()) + " (~motion_failure: skip)");
+      }
+      out.motion_failure = e.what();
+    }
+  }
   input.cloud = std::move(cloud.cloud);
   out.cloud_points = static_cast<int>(input.cloud.size());
   out.invalid_points = cloud.non_finite + cloud.implausible;

@@ -54,6 +54,21 @@ NodeParams readNodeParamsYaml(const std::string& path) {
   integer("num_rings", p.num_rings);
   number("max_output_depth", p.max_output_depth);
   integer("cloud_stride", p.cloud_stride);
+  const auto word = [&](const char* key, std::string& v) {  // the first word, as approximate_sync
+    const cv::FileNode node = file[key];
+    if (node.isString()) v = node.string().substr(0, node.string().find_first_of(" \t#"));
+  };
+  word("fixed_frame", p.fixed_frame);
+  word("motion_failure", p.motion_failure);
+  integer("motion_samples", p.motion_samples);
+  number("max_point_time", p.max_point_time);
+  if (p.motion_failure != "uncompensated" && p.motion_failure != "skip") {
+    throw std::runtime_error(path + ": motion_failure must be uncompensated or skip, not '" +
+                             p.motion_failure + "'");
+  }
+  if (p.motion_samples < 1 || p.motion_samples > 100 || !(p.max_point_time > 0.0)) {
+    throw std::runtime_error(path + ": motion_samples must be in [1, 100], max_point_time > 0");
+  }
   if (p.queue_size < 1 || p.sweep_buffer_size < 1 || p.max_time_offset < 0 ||
       p.max_sweep_wait < 0 || p.cloud_stride < 1 || p.num_rings < 1) {
     throw std::runtime_error(path +

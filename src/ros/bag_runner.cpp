@@ -45,7 +45,8 @@ Options:
   --params YAML       algorithm parameters (config/fusion.yaml layout; default: the built-in ones)
   --node-params YAML  synchronisation parameters (config/fusion_node.yaml layout: approximate_sync,
                       queue_size, max_time_offset, max_sweep_wait, sweep_buffer_size, num_rings,
-                      max_output_depth, cloud_stride)
+                      max_output_depth, cloud_stride; fixed_frame, motion_samples, motion_failure,
+                      max_point_time: ego-motion compensation from the bag's /tf, doc/motion.md)
   --approximate-sync  ApproximateTime image sync (as approximate_sync: true)
   --method NAME       fused_bi | fused_bf | pms | lidar_bi | lidar_bf (overrides --params)
   --start S, --end S  only the image sets whose left image was recorded in [S, E) seconds after
@@ -250,15 +251,22 @@ void Runner::finishSet(lsf::SetOutcome& s, lsf::FusionPipeline& pipeline,
   try {
     Eigen::Isometry3d T;
     try {
-      T = tf2::transformToEigen(
-          pairing_->tf().lookupTransform(camera_frame, lidar_frame, match.sweep_stamp));
+      // At the image stamp when the sweep is moved there (~fixed_frame), as the nodelet does.
+      T = tf2::transformToEigen(pairing_->tf().lookupTransform(
+          camera_frame, lidar_frame,
+          node_params_.fixed_frame.empty() ? match.sweep_stamp : match.image_stamp));
     } catch (const tf2::TransformException& e) {
       throw std::runtime_error("no transform from '" + lidar_frame + "' (" + o_.topics.cloud +
                                ") to '" + camera_frame + "' (" + o_.topics.left_image +
                                ") at the sweep stamp " + lsf::stampName(match.sweep_stamp) +
                                " in /tf_static or /tf: " + e.what());
     }
-    const lsf::FusedSet set = lsf::fuseSet(match, T, pipeline, node_params_);
+    const lsf::FusedSet set = lsf::fuseSet(match, T, pipeline, node_params_, pairing_->tf());
+    if (!set.motion_failure.empty()) {
+      std::cerr << "\nbag_runner: warning: image set " << name
+                << " processed without ego-motion compensation (~motion_failure: uncompensated): "
+                << set.motion_failure << "\n";
+    }
     writer.write(match, s.receipt, set, params_);
     rows_[s.stamp] = lsf::okRow(s.stamp, match, set, lsf::methodName(params_.method));
     partial_ << rows_[s.stamp] << std::flush;  // for --resume after a kill

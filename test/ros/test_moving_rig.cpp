@@ -5,7 +5,9 @@
 // depth at the image instant and against the offline compensation of the same frame
 // (core/motion_compensation.h); the uncompensated one shows what the motion costs.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -21,10 +23,13 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "child_process.h"
 #include "lidar_stereo_fusion/FusionStats.h"
 #include "lidar_stereo_fusion/core/metrics.h"
 #include "lidar_stereo_fusion/sim/moving_rig.h"
+#include "run_command.h"
 #include "synthetic_input.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -164,9 +169,10 @@ TEST_F(MovingRig, CompensatedDepthMatchesTheTruthAtTheImageInstant) {
   }
   pubs["/velodyne_points"] = nh_.advertise<sensor_msgs::PointCloud2>("/velodyne_points", 5);
   ASSERT_TRUE(lsf::test::waitFor(30.0, [&] {
-    return pubs["/velodyne_points"].getNumSubscribers() >= 3 &&
-           pubs["/tf"].getNumSubscribers() >= 3 &&
-           pubs["/stereo/left/image_rect_color"].getNumSubscribers() >= 3;
+    for (auto& [topic, pub] : pubs) {
+      if (topic != "/tf_static" && pub.getNumSubscribers() < 3) return false;
+    }
+    return true;
   })) << "the nodelets did not subscribe to the inputs and /tf";
 
   rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
@@ -231,6 +237,37 @@ TEST_F(MovingRig, CompensatedDepthMatchesTheTruthAtTheImageInstant) {
     EXPECT_GT(comp.second, 0.95) << k;
     EXPECT_LT(comp.first, 1.1 * offline.first + 0.01) << k;
     EXPECT_GT(raw.first, 3.0 * comp.first) << k;
+  }
+
+  // bag_runner on the same bag with ~fixed_frame: the nodelet's compensated depth, to the PNG's
+  // resolution (1/256 m).
+  {
+    const std::filesystem::path out = dir / "bag_runner";
+    std::filesystem::remove_all(out);
+    std::ofstream((dir / "node.yaml").string()) << "fixed_frame: odom\nmax_time_offset: 0.15\n";
+    const auto [status, output] = lsf::test::runCommand(
+        std::string(LSF_BAG_RUNNER) + " --bag " + bag_path + " --out " + out.string() +
+        " --node-params " + (dir / "node.yaml").string() + " 2>&1");
+    EXPECT_EQ(status, 0) << output;
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const ros::Time& stamp : image_stamps) {
+      char name[40];
+      std::snprintf(name, sizeof(name), "%u.%09u.png", stamp.sec, stamp.nsec);
+      const cv::Mat png = cv::imread((out / name).string(), cv::IMREAD_UNCHANGED);
+      ASSERT_EQ(png.type(), CV_16UC1) << name << "\n" << output;
+      const cv::Mat1f& nodelet = depths_["/moving_comp"][stamp];
+      int compared = 0, differ = 0;
+      for (int v = 0; v < png.rows; ++v) {
+        for (int u = 0; u < png.cols; ++u) {
+          const float offline = png.at<uint16_t>(v, u) / 256.f, live = nodelet(v, u);
+          if (offline == 0.f || !std::isfinite(live)) continue;
+          ++compared;
+          if (std::abs(offline - live) > 1.f / 256.f) ++differ;
+        }
+      }
+      EXPECT_GT(compared, png.rows * png.cols / 2) << name;
+      EXPECT_EQ(differ, 0) << name;
+    }
   }
 
   // A frame whose ego-motion is not on TF (2 s after the last one): /moving_comp warns, naming

@@ -16,6 +16,8 @@
 #include "lidar_stereo_fusion/ros/bag_pairing.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 
+#include <tf2/buffer_core.h>
+
 namespace lidar_stereo_fusion {
 
 /// One processed set: the core result and what the ROS layer knows of it.
@@ -27,13 +29,17 @@ struct FusedSet {
   double conversion_ms = 0;  ///< message -> core types
   RingRecovery rings;
   int cloud_points = 0, invalid_points = 0;
+  bool motion_compensated = false;  ///< moved to the image stamp through ~fixed_frame
+  std::string motion_failure;       ///< why not, with ~fixed_frame set and processed uncompensated
 };
 
 /// Runs the fusion on a matched set with LiDAR -> camera `T_cam_lidar`, exactly as the node's
-/// worker does. Throws std::runtime_error naming the problem (conversion, no finite point,
-/// pipeline failure).
+/// worker does, ego-motion compensation through node_params.fixed_frame included (`tf`: the bag's
+/// /tf and /tf_static). Throws std::runtime_error naming the problem (conversion, no finite point,
+/// pipeline failure, missing ego-motion with ~motion_failure: skip).
 FusedSet fuseSet(const InputMatch& match, const Eigen::Isometry3d& T_cam_lidar,
-                 FusionPipeline& pipeline, const NodeParams& node_params);
+                 FusionPipeline& pipeline, const NodeParams& node_params,
+                 const tf2::BufferCore& tf);
 
 /// Which files to write besides the depth PNG.
 struct OutputOptions {
