@@ -1,7 +1,15 @@
 // LiDAR-guided PatchMatch stereo (Bleyer et al. 2011 + the LiDAR term of Xu et al.): the driver.
 // The steps live in their own files: plane.h (the plane xi), cost.h/.cpp (C, w, phi),
 // propagation.h/.cpp (initialisation, spatial propagation, refinement), view_propagation.cpp,
-// post_processing.h/.cpp (left-right check, filling).
+// post_processing.h/.cpp (left-right check, filling); the parameters' checks in params.cpp.
+//
+// compute() runs the stages in order, one function each:
+//   prepareLevel         the views (images, prior, bounds) and what this level does (Level)
+//   startFromLevelBelow  coarse start: the planes of the level below, up-sampled, and its
+//                        left-right check (checkLevelBelow, skipInconsistent)
+//   searchViews          initialisation, then per iteration the left view's sweep and the right
+//                        view's (searchRightView: view propagation in, sweep, view propagation back)
+//   postProcess          disparities, left-right check (consistencyCheck), hole filling
 //
 // Per iteration: left view sweep. In the last `right_iterations` iterations also: view
 // propagation of the left planes into the right view, right view sweep, view propagation back
@@ -17,8 +25,6 @@
 // unbounded_scale > 1 the pixels without bounds keep the level below's plane (kKeptFromGuide).
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
-#include <string>
 
 #include <opencv2/imgproc.hpp>
 
