@@ -13,6 +13,7 @@
 #include "lidar_stereo_fusion/io/accuracy_tables.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
+#include "lidar_stereo_fusion/io/simd_env.h"
 
 namespace lsf = lidar_stereo_fusion;
 
@@ -104,10 +105,12 @@ int run(const Options& o) {
   options.progress = &std::cerr;
   options.methods = o.methods;
   if (!o.params.empty()) lsf::loadParamsYaml(o.params, options.fused);
+  lsf::applySimdEnvironment(options.fused);
   const std::string paper = std::string(LSF_SOURCE_DIR) + "/config/paper.yaml";
   if (std::filesystem::is_regular_file(paper)) {
     lsf::FusionParams params;
     lsf::loadParamsYaml(paper, params);
+    params.patchmatch.simd_path = options.fused.patchmatch.simd_path;
     options.paper = params;
   } else {
     std::cout << "> note: " << paper << " not found: the 'paper' row is skipped.\n\n";

@@ -15,12 +15,12 @@
 
 #include <opencv2/calib3d.hpp>
 
-#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
 #include "lidar_stereo_fusion/io/report.h"
+#include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/sim/synthetic_frame.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -184,6 +184,7 @@ int run(const Options& o) {
   if (!o.params.empty()) lsf::loadParamsYaml(o.params, params);
   if (!o.method.empty()) params.method = lsf::parseMethod(o.method);
   params.patchmatch.num_threads = o.threads;
+  lsf::applySimdEnvironment(params);
   const int threads = o.threads > 0 ? o.threads : omp_get_num_procs();
   omp_set_num_threads(threads);
   cv::setNumThreads(threads);
@@ -197,7 +198,7 @@ int run(const Options& o) {
       "runs\n",
       cases.size() == 1 ? cases.front().name.c_str() : "every frame", size.width, size.height,
       cases.front().input.cloud.size(), lsf::methodName(params.method).c_str(), threads,
-      lsf::simdLevel(), o.repeat);
+      lsf::simdPathName(params.patchmatch.simd_path), o.repeat);
   cv::Ptr<cv::StereoSGBM> sgbm;
   if (o.sgbm) {
     sgbm = cv::StereoSGBM::create(0, 128, 5, 8 * 3 * 25, 32 * 3 * 25, 1, 63, 10, 100, 32,

@@ -26,6 +26,7 @@
 #include "lidar_stereo_fusion/io/pcd.h"
 #include "lidar_stereo_fusion/io/photometric_check.h"
 #include "lidar_stereo_fusion/io/report.h"
+#include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/io/visualization.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -129,6 +130,7 @@ lsf::FusionParams loadParams(const Options& o) {
   lsf::FusionParams params;
   if (!o.params.empty()) lsf::loadParamsYaml(o.params, params);
   if (o.method) params.method = lsf::parseMethod(*o.method);
+  lsf::applySimdEnvironment(params);
   params.validate();
   return params;
 }

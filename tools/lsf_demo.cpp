@@ -26,6 +26,7 @@
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/io/holdout.h"
 #include "lidar_stereo_fusion/io/kitti.h"
+#include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/io/visualization.h"
 #include "lidar_stereo_fusion/sim/kitti_export.h"
 #include "lidar_stereo_fusion/sim/occlusion_truth.h"
@@ -172,6 +173,7 @@ lsf::FusionParams demoParams(lsf::Method method, int width) {
   lsf::FusionParams params;
   params.method = method;
   params.patchmatch.max_disparity = std::max(32.0, std::round(192.0 * width / 1242.0));
+  lsf::applySimdEnvironment(params);
   return params;
 }
 

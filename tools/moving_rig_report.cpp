@@ -12,6 +12,7 @@
 
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
+#include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/sim/moving_rig.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -88,6 +89,7 @@ int run(int argc, char** argv) {
       throw lsf::UsageError("--methods: unknown method '" + name +
                             "' (valid: fused, lidar_bi, pms, paper)");
     }
+    lsf::applySimdEnvironment(params);
     methods.emplace_back(name, params);
   }
   std::cout << "Synthetic street " << w << "x" << h << ", " << base.rings

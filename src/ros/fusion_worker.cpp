@@ -16,6 +16,7 @@
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/motion_compensation.h"
+#include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/ros/ego_motion.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
 #include "lidar_stereo_fusion/ros/ros_params.h"
@@ -53,6 +54,9 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
     params = FusionParams();
   }
   params_ = params;
+  std::string simd_warning;  // the SIMD path is no parameter: LSF_SIMD, kept by reconfigure
+  params_.patchmatch.simd_path = simdPathFromEnvironment(&simd_warning);
+  if (!simd_warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << simd_warning);
   ros_params::writeParams(pnh_, params_);
 
   // Live parameters: start from the values just read, then follow dynamic_reconfigure.
@@ -92,6 +96,7 @@ void FusionWorker::reconfigureCb(FusionConfig& config, uint32_t /*level*/) {
   FusionParams candidate;
   try {
     candidate = ros_params::fromConfig(config);
+    candidate.patchmatch.simd_path = current.patchmatch.simd_path;
     candidate.validate();
   } catch (const std::exception& e) {
     // Refused as a whole: the response (and `dynparam get`) carry the values in force.

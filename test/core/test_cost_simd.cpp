@@ -18,6 +18,8 @@
 #include "lidar_stereo_fusion/core/patchmatch/median_kernel.h"
 #include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/patchmatch/view_state.h"
+#include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/io/simd_env.h"
 #include "test_scenes.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -25,14 +27,27 @@ namespace pm = lidar_stereo_fusion::patchmatch;
 
 namespace {
 
-/// Restores the process's SIMD path when a test ends.
-class SimdPathGuard {
+/// Sets (or unsets, for nullptr) LSF_SIMD while a test runs, and restores it when it ends.
+class SimdEnvironment {
  public:
-  SimdPathGuard() : saved_(lsf::activeSimdPath()) {}
-  ~SimdPathGuard() { lsf::setSimdPath(saved_); }
+  explicit SimdEnvironment(const char* value) {
+    const char* old = std::getenv("LSF_SIMD");
+    had_ = old != nullptr;
+    if (had_) saved_ = old;
+    set(value);
+  }
+  ~SimdEnvironment() { set(had_ ? saved_.c_str() : nullptr); }
+  void set(const char* value) {
+    if (value == nullptr) {
+      unsetenv("LSF_SIMD");
+    } else {
+      setenv("LSF_SIMD", value, 1);
+    }
+  }
 
  private:
-  lsf::SimdPath saved_;
+  bool had_ = false;
+  std::string saved_;
 };
 
 #define SKIP_WITHOUT_AVX2()                                                               \
@@ -176,7 +191,6 @@ struct CostCase {
 /// matching outside the other image; then with random bounds (early exit). Square or round.
 void compareShape(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int radius, int stride,
                   bool round) {
-  SimdPathGuard guard;
   std::mt19937 rng(seed);
   const int w = 97, h = 41;
   lsf::PatchMatchParams p;
@@ -193,16 +207,17 @@ void compareShape(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int rad
   if (cc.with_prior) randomPrior(w, h, rng, prior, confidence);
   const lsf::ViewInput left(randomImage(w, h, rng), prior, {}, confidence);
   const lsf::ViewInput right(randomImage(w, h, rng), prior, {}, confidence);
-  lsf::setSimdPath(lsf::SimdPath::kAvx2);  // views with texels, for both kernels
   pm::ViewState lv, rv;
   pm::prepareView(left, p, -1.f, lv);
   pm::prepareView(right, p, +1.f, rv);
   for (const pm::ViewState* self : {&lv, &rv}) {
     const pm::ViewState& other = self == &lv ? rv : lv;
-    lsf::setSimdPath(wide);
-    const pm::MatchingCost fast(p, *self, other);
-    lsf::setSimdPath(lsf::SimdPath::kBaseline);
-    const pm::MatchingCost base(p, *self, other);
+    // Both costs at once in one process, each with its own path.
+    lsf::PatchMatchParams fast_params = p, base_params = p;
+    fast_params.simd_path = wide;
+    base_params.simd_path = lsf::SimdPath::kBaseline;
+    const pm::MatchingCost fast(fast_params, *self, other);
+    const pm::MatchingCost base(base_params, *self, other);
     ASSERT_TRUE(fast.usesAvx2());
     ASSERT_FALSE(base.usesAvx2());
     pm::WindowCache fast_cache, base_cache;
@@ -269,32 +284,65 @@ double differingFraction(const cv::Mat1f& a, const cv::Mat1f& b) {
 
 }  // namespace
 
-TEST(CostSimd, ReportsTheActivePath) {
-  const std::string level = lsf::simdLevel();
+TEST(CostSimd, DefaultsToTheWidestPath) {
+  const lsf::SimdPath widest = lsf::widestSimdPath();
+  const std::string level = lsf::simdPathName(widest);
   EXPECT_TRUE(level == "avx512" || level == "avx2" || level == "baseline") << level;
-  EXPECT_TRUE(lsf::simdPathSupported(lsf::activeSimdPath())) << level;
+  EXPECT_TRUE(lsf::simdPathSupported(widest)) << level;
   EXPECT_TRUE(lsf::simdPathSupported(lsf::SimdPath::kBaseline));
+  EXPECT_EQ(lsf::PatchMatchParams().simd_path, widest);
   if (!lsf::cpuHasAvx2Fma()) {
     EXPECT_EQ(level, "baseline");
     EXPECT_FALSE(lsf::cpuHasAvx512()) << "the AVX-512 path needs the AVX2 one's window";
   }
-  // Unset or "avx512", LSF_SIMD leaves the widest path the CPU runs.
-  const char* env = std::getenv("LSF_SIMD");
-  if (env == nullptr || std::string(env) == "avx512") {
-    EXPECT_EQ(level, lsf::cpuHasAvx512() ? "avx512" : (lsf::cpuHasAvx2Fma() ? "avx2" : "baseline"));
+  EXPECT_EQ(level, lsf::cpuHasAvx512() ? "avx512" : (lsf::cpuHasAvx2Fma() ? "avx2" : "baseline"));
+  for (const lsf::SimdPath path :
+       {lsf::SimdPath::kBaseline, lsf::SimdPath::kAvx2, lsf::SimdPath::kAvx512}) {
+    lsf::SimdPath parsed = lsf::SimdPath::kBaseline;
+    EXPECT_TRUE(lsf::parseSimdPath(lsf::simdPathName(path), parsed));
+    EXPECT_EQ(parsed, path);
+    EXPECT_EQ(lsf::capSimdPath(path), lsf::simdPathSupported(path) ? path : widest);
   }
-  std::printf("[          ] active path %s; AVX2 + FMA %s, AVX-512 %s\n", level.c_str(),
+  lsf::SimdPath untouched = lsf::SimdPath::kAvx2;
+  EXPECT_FALSE(lsf::parseSimdPath("sse2", untouched));
+  EXPECT_EQ(untouched, lsf::SimdPath::kAvx2);
+  std::printf("[          ] widest path %s; AVX2 + FMA %s, AVX-512 %s\n", level.c_str(),
               lsf::cpuHasAvx2Fma() ? "yes" : "no", lsf::cpuHasAvx512() ? "yes" : "no");
 }
 
-TEST(CostSimd, SelectingAnUnsupportedPathThrows) {
-  SimdPathGuard guard;
+TEST(CostSimd, ToolsTakeThePathFromLsfSimd) {
+  const lsf::SimdPath widest = lsf::widestSimdPath();
+  SimdEnvironment env(nullptr);
+  EXPECT_EQ(lsf::simdPathFromEnvironment(), widest);  // unset: the widest
+  env.set("");
+  EXPECT_EQ(lsf::simdPathFromEnvironment(), widest);
+  env.set("baseline");
+  EXPECT_EQ(lsf::simdPathFromEnvironment(), lsf::SimdPath::kBaseline);
+  env.set("avx2");  // a cap: baseline on a CPU without AVX2
+  EXPECT_EQ(lsf::simdPathFromEnvironment(), lsf::capSimdPath(lsf::SimdPath::kAvx2));
+  env.set("avx512");
+  EXPECT_EQ(lsf::simdPathFromEnvironment(), widest);
+  env.set("fastest");
+  std::string warning;
+  EXPECT_EQ(lsf::simdPathFromEnvironment(&warning), widest);
+  EXPECT_NE(warning.find("LSF_SIMD=fastest is not baseline, avx2 or avx512"), std::string::npos)
+      << warning;
+  env.set("baseline");
+  lsf::FusionParams params;
+  EXPECT_EQ(lsf::applySimdEnvironment(params), lsf::SimdPath::kBaseline);
+  EXPECT_EQ(params.patchmatch.simd_path, lsf::SimdPath::kBaseline);
+}
+
+TEST(CostSimd, AnUnsupportedPathIsRejected) {
   for (const lsf::SimdPath path : {lsf::SimdPath::kAvx2, lsf::SimdPath::kAvx512}) {
+    lsf::PatchMatchParams p;
+    p.simd_path = path;
     if (lsf::simdPathSupported(path)) {
-      EXPECT_NO_THROW(lsf::setSimdPath(path));
-      EXPECT_EQ(lsf::activeSimdPath(), path);
+      EXPECT_NO_THROW(p.validate());
+      EXPECT_NO_THROW(lsf::PatchMatchStereo{p});
     } else {
-      EXPECT_THROW(lsf::setSimdPath(path), std::invalid_argument);
+      EXPECT_THROW(p.validate(), std::invalid_argument);
+      EXPECT_THROW(lsf::PatchMatchStereo{p}, std::invalid_argument);
     }
   }
 }
@@ -375,7 +423,6 @@ TEST(CostSimd, WeightedMedianKernelsAgree) {
 }
 
 TEST(CostSimd, SidesAreTheShiftedPlanesCostsWhereTheOtherViewIsLinear) {
-  SimdPathGuard guard;
   // The right view is a ramp in x (linear colour, constant gradient inside), so interpolating on
   // the interval of d's match is exact for d -+ h too.
   std::mt19937 rng(12);
@@ -391,8 +438,8 @@ TEST(CostSimd, SidesAreTheShiftedPlanesCostsWhereTheOtherViewIsLinear) {
   std::vector<lsf::SimdPath> paths = widePaths();
   paths.insert(paths.begin(), lsf::SimdPath::kBaseline);
   for (const lsf::SimdPath path : paths) {
-    lsf::setSimdPath(path);
     lsf::PatchMatchParams p;
+    p.simd_path = path;
     pm::ViewState lv, rv;
     pm::prepareView(left, p, -1.f, lv);
     pm::prepareView(right, p, +1.f, rv);
@@ -410,7 +457,8 @@ TEST(CostSimd, SidesAreTheShiftedPlanesCostsWhereTheOtherViewIsLinear) {
       cost.aggregateSides(cache, plane, step, lower, upper);
       const float exact_lower = cost.aggregate(cache, {a, b, plane.c - step}, inf);
       const float exact_upper = cost.aggregate(cache, {a, b, plane.c + step}, inf);
-      const auto where = ::testing::Message() << lsf::simdLevel() << " pixel " << px << "," << py;
+      const auto where = ::testing::Message() << lsf::simdPathName(path) << " pixel " << px
+                                              << "," << py;
       EXPECT_NEAR(lower, exact_lower, 1e-4 * exact_lower) << where;
       EXPECT_NEAR(upper, exact_upper, 1e-4 * exact_upper) << where;
     }
@@ -419,7 +467,6 @@ TEST(CostSimd, SidesAreTheShiftedPlanesCostsWhereTheOtherViewIsLinear) {
 
 TEST(CostSimd, PatchMatchSameOnBothPaths) {
   SKIP_WITHOUT_AVX2();
-  SimdPathGuard guard;
   // A slanted textured plane with a LiDAR-like prior: rows every 4th line, holes, mixed confidence.
   const auto s = lsf::test::PlaneScene::make(240, 120, 0.06, 0.03, 12.0, 41);
   cv::Mat1f prior(120, 240, 0.f), confidence(120, 240, 0.f);
@@ -439,17 +486,25 @@ TEST(CostSimd, PatchMatchSameOnBothPaths) {
     }
     p.num_threads = 2;
     const lsf::ViewInput left(s.left, prior, {}, confidence), right(s.right, cv::Mat1f(), {});
-    lsf::setSimdPath(lsf::SimdPath::kBaseline);
-    const auto base = lsf::PatchMatchStereo(p).compute(left, right);
+    // One matcher per path, alive side by side in one process: each keeps its own path.
+    lsf::PatchMatchParams base_params = p;
+    base_params.simd_path = lsf::SimdPath::kBaseline;
+    lsf::PatchMatchStereo base_matcher(base_params);
+    const auto base = base_matcher.compute(left, right);
     for (const lsf::SimdPath wide : widePaths()) {
-      lsf::setSimdPath(wide);
-      const auto fast = lsf::PatchMatchStereo(p).compute(left, right);
+      lsf::PatchMatchParams fast_params = p;
+      fast_params.simd_path = wide;
+      lsf::PatchMatchStereo fast_matcher(fast_params);
+      const auto fast = fast_matcher.compute(left, right);
+      const auto again = base_matcher.compute(left, right);  // after the other path ran
+      EXPECT_EQ(cv::norm(again.disparity, base.disparity, cv::NORM_INF), 0.0);
+      const char* level = lsf::simdPathName(wide);
       const double differ = differingFraction(fast.disparity, base.disparity);
-      std::printf("[          ] %s, variant %d: %.4f %% of pixels differ by > 1e-3 px\n",
-                  lsf::simdLevel(), variant, 100 * differ);
-      EXPECT_LE(differ, 1e-3) << lsf::simdLevel() << " variant " << variant;
+      std::printf("[          ] %s, variant %d: %.4f %% of pixels differ by > 1e-3 px\n", level,
+                  variant, 100 * differ);
+      EXPECT_LE(differ, 1e-3) << level << " variant " << variant;
       EXPECT_EQ(cv::norm(fast.disparity, base.disparity, cv::NORM_INF), 0.0)
-          << lsf::simdLevel() << " variant " << variant
+          << level << " variant " << variant
           << ": the kernels are bit-identical, so should be the results";
     }
   }

@@ -44,7 +44,7 @@ TEST(PatchMatchPostProcessing, ConfidentPriorFillsElseTheBackgroundNeighbour) {
   cv::Mat1f disparity = pm::disparityOf(v.left);
   cv::Mat1b bad = cv::Mat1b::zeros(1, 7);
   bad(0, 2) = bad(0, 4) = 255;
-  pm::fillHoles(v.left, bad, 1, 10.f, 0.5f, 192.f, disparity, 1);
+  pm::fillHoles(v.left, bad, {1, 10.f, 0.5f, 192.f, p.simd_path}, disparity, 1);
   EXPECT_EQ(disparity(0, 2), 9.f);  // the prior
   EXPECT_EQ(disparity(0, 4), 3.f);  // min(12 from the left, 3 from the right): the background
   EXPECT_EQ(disparity(0, 0), 12.f);
@@ -59,7 +59,7 @@ TEST(PatchMatchPostProcessing, AFillNeverPassesTheSearchRange) {
   cv::Mat1f disparity = pm::disparityOf(v.left);
   cv::Mat1b bad = cv::Mat1b::zeros(1, 9);
   for (int x = 5; x < 9; ++x) bad(0, x) = 255;
-  pm::fillHoles(v.left, bad, 2, 10.f, 0.5f, 192.f, disparity, 1);
+  pm::fillHoles(v.left, bad, {2, 10.f, 0.5f, 192.f, p.simd_path}, disparity, 1);
   for (int x = 5; x < 9; ++x) EXPECT_LE(disparity(0, x), 192.f) << x;
   EXPECT_EQ(disparity(0, 8), 0.f);    // its window (pixels 6, 8) holds no fill: left empty
   EXPECT_EQ(disparity(0, 5), 140.f);  // the median of its window: pixels 3 (140) and 5 (180)

@@ -9,9 +9,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/upsampling.h"
 
 namespace lidar_stereo_fusion {
+
+namespace patchmatch {
+struct SearchOptions;
+class PlaneSearch;
+}  // namespace patchmatch
 
 struct PatchMatchParams {
   /// Support window (2r+1)^2 [px]. The paper found size ~10 best for its fused cost, ~40 for plain
@@ -142,6 +148,11 @@ struct PatchMatchParams {
   bool fine_refine = false;
   int num_threads = 0;           ///< 0 = all cores (at most 256)
   uint64_t seed = 42;
+  /// The cost kernels' instructions (patchmatch/simd.h): every path gives the same result, only
+  /// the speed differs. Not a tunable parameter (not in the parameter table): a value the caller
+  /// gives, by default the widest this CPU runs; the tools take it from LSF_SIMD (io/simd_env.h).
+  /// Each object keeps its own: two pipelines in one process cannot change each other's.
+  SimdPath simd_path = widestSimdPath();
   void validate() const;
 };
 
@@ -190,8 +201,26 @@ class PatchMatchStereo {
   std::shared_ptr<PatchMatchStereo> coarse_;  ///< the coarse start's solver (coarse_scale > 1)
   bool intermediate_ = false;  ///< a reduced level of another solver's coarse start
 
+  // compute()'s stages, in order (patchmatch.cpp): prepare the views, start from the coarse
+  // start's planes, search each view (initialisation, propagation, refinement, view propagation),
+  // post-process (left-right check, hole filling, weighted median).
+  struct Level;
+  Level prepareLevel(const ViewInput& left, const ViewInput& right, bool guided);
   /// The coarse start's level below, on the views reduced by coarse_scale.
   PatchMatchResult levelBelow(const ViewInput& left, const ViewInput& right);
+  /// Coarse start: the level below's planes guide this level; its left-right check decides
+  /// which pixels are left to the fill (skip_inconsistent) or marked inconsistent here.
+  void startFromLevelBelow(const ViewInput& left, const ViewInput& right, Level& level);
+  cv::Mat1b checkLevelBelow(const PatchMatchResult& coarse, const Level& level) const;
+  void skipInconsistent(const cv::Mat1b& below, const Level& level);
+  void searchViews(const Level& level);
+  void searchOptions(const Level& level, patchmatch::SearchOptions& left,
+                     patchmatch::SearchOptions& right) const;
+  /// One iteration of the right view: view propagation in, sweep, view propagation back.
+  void searchRightView(const Level& level, const patchmatch::PlaneSearch& left,
+                       const patchmatch::PlaneSearch& right, bool right_refines, int iteration);
+  PatchMatchResult postProcess(const Level& level);
+  cv::Mat1b consistencyCheck(const PatchMatchResult& result, const Level& level) const;
   /// A level that does not search (search_scale): the level below's result, up-sampled.
   PatchMatchResult upsampledResult(const ViewInput& left, const ViewInput& right);
 };

@@ -62,10 +62,23 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
     : p_(params), self_(self), other_(other) {
   offsets_ = windowOffsets(params.window_radius, params.window_stride, params.window_dyadic);
   rows_ = windowRows(offsets_, params.window_radius, params.window_round);
+  tabulateSupportWeight();
+  readCostWeights();
+  avx2_ = params.simd_path != SimdPath::kBaseline;
+  avx512_ = params.simd_path == SimdPath::kAvx512;
+  buildInteriorWindow();
+  kernel_self_ = kernelSelf();
+  kernel_ = kernelConstants();
+}
+
+void MatchingCost::tabulateSupportWeight() {
   weight_lut_.resize(kLutSize);
   for (int i = 0; i < kLutSize; ++i) {
-    weight_lut_[i] = std::exp(-(i / kLutScale) / static_cast<float>(params.weight_delta));
+    weight_lut_[i] = std::exp(-(i / kLutScale) / static_cast<float>(p_.weight_delta));
   }
+}
+
+void MatchingCost::readCostWeights() {
   wa_ = static_cast<float>(p_.alpha);
   wb_ = static_cast<float>(p_.beta);
   wg_ = static_cast<float>(p_.gamma);
@@ -77,8 +90,9 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   use_prior_ = wg_ > 0.f && !self_.prior.empty();
   weighted_ = p_.confidence_weighting;
   img_norm_ = wa_ + wb_ > 0.f ? 1.f / (wa_ + wb_) : 0.f;
-  avx2_ = activeSimdPath() != SimdPath::kBaseline;
-  avx512_ = activeSimdPath() == SimdPath::kAvx512;
+}
+
+void MatchingCost::buildInteriorWindow() {
   // A window wholly inside the image has the same samples at the same offsets for every pixel;
   // the padding repeats the first sample.
   const int other_stride = kTexelChannels * other_.width;
@@ -95,47 +109,65 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
   while (interior_dx_.size() % kSimdBlock != 0) {
     add_interior(static_cast<int>(interior_dx_[0]), static_cast<int>(interior_dy_[0]));
   }
+}
+
+KernelSelf MatchingCost::kernelSelf() const {
   const bool pixel_steps = !use_prior_ || (static_cast<int>(self_.prior.step1()) == self_.width &&
                                            static_cast<int>(self_.trust.step1()) == self_.width);
-  const float x_max = static_cast<float>(self_.width - 1);
-  kernel_self_ = KernelSelf{self_.texels.empty() ? nullptr : self_.texels.data()->v,
-                            use_prior_ ? self_.prior.ptr<float>(0) : nullptr,
-                            use_prior_ ? self_.trust.ptr<float>(0) : nullptr,
-                            use_prior_ ? static_cast<int>(self_.prior.step1()) : 0,
-                            use_prior_ ? static_cast<int>(self_.trust.step1()) : 0,
-                            self_.width,
-                            self_.height,
-                            other_stride,
-                            offsets_.data(),
-                            static_cast<int>(offsets_.size()),
-                            rows_.first.data(),
-                            rows_.end.data(),
-                            rows_.count,
-                            weight_lut_.data(),
-                            kLutSize,
-                            kLutScale,
-                            weighted_,
-                            wg_,
-                            img_norm_,
-                            ldisp_,
-                            interior_dx_.data(),
-                            interior_dy_.data(),
-                            interior_row_.data(),
-                            interior_texel_.data(),
-                            pixel_steps ? interior_pixel_.data() : nullptr};
+  return KernelSelf{self_.texels.empty() ? nullptr : self_.texels.data()->v,
+                    use_prior_ ? self_.prior.ptr<float>(0) : nullptr,
+                    use_prior_ ? self_.trust.ptr<float>(0) : nullptr,
+                    use_prior_ ? static_cast<int>(self_.prior.step1()) : 0,
+                    use_prior_ ? static_cast<int>(self_.trust.step1()) : 0,
+                    self_.width,
+                    self_.height,
+                    kTexelChannels * other_.width,
+                    offsets_.data(),
+                    static_cast<int>(offsets_.size()),
+                    rows_.first.data(),
+                    rows_.end.data(),
+                    rows_.count,
+                    weight_lut_.data(),
+                    kLutSize,
+                    kLutScale,
+                    weighted_,
+                    wg_,
+                    img_norm_,
+                    ldisp_,
+                    interior_dx_.data(),
+                    interior_dy_.data(),
+                    interior_row_.data(),
+                    interior_texel_.data(),
+                    pixel_steps ? interior_pixel_.data() : nullptr};
+}
+
+KernelConstants MatchingCost::kernelConstants() const {
   // The L1 sums are in texel units: alpha min(L1 / 64, lambda) = alpha / 64 min(L1, 64 lambda),
   // exactly (powers of two).
   const float scale = static_cast<float>(kTexelScale);
-  kernel_ = KernelConstants{other_.texels.empty() ? nullptr : other_.texels.data()->v,
-                            x_max,
-                            x_max - 1e-3f,
-                            self_.match_sign,
-                            wa_ / scale,
-                            use_grad_ ? wb_ / scale : 0.f,
-                            lcol_ * scale,
-                            lgrad_ * scale,
-                            ldisp_,
-                            outside_cost_};
+  const float x_max = static_cast<float>(self_.width - 1);
+  return KernelConstants{other_.texels.empty() ? nullptr : other_.texels.data()->v,
+                         x_max,
+                         x_max - 1e-3f,
+                         self_.match_sign,
+                         wa_ / scale,
+                         use_grad_ ? wb_ / scale : 0.f,
+                         lcol_ * scale,
+                         lgrad_ * scale,
+                         ldisp_,
+                         outside_cost_};
+}
+
+PhiWeights MatchingCost::phiWeights(float w, float trust) const {
+  if (weighted_) {
+    // phi = (1 - kappa) / (alpha + beta) rho_img + kappa rho_lid, kappa = gamma c(p').
+    const float kappa = wg_ * trust;
+    return PhiWeights{w * (1.f - kappa) * img_norm_, w * kappa, 0.f};
+  }
+  // The paper: phi = rho_img + gamma rho_lid, or + gamma lambda_disp without a prior.
+  const bool measured = trust > 0.f;
+  return PhiWeights{w, measured ? w * wg_ : 0.f,
+                    use_prior_ && !measured ? w * wg_ * ldisp_ : 0.f};
 }
 
 float MatchingCost::supportWeight(float l1) const {
@@ -145,21 +177,25 @@ float MatchingCost::supportWeight(float l1) const {
 void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
   const size_t n = rows_.count + kSimdBlock;  // room for the padding
   if (cache.xs.size() < n) cache.reserve(n);
-  if (avx2_) {
-    const KernelWindowOut out{cache.xs.data(),       cache.ys.data(),     cache.w_img.data(),
-                              cache.w_lidar.data(),  cache.priors.data(), cache.texels.data()->v,
-                              cache.texel_row.data()};
-    cache.count = buildWindowAvx2(kernel_self_, px, py, out, cache.padded, cache.constant);
-    cache.kernel = KernelWindow{cache.xs.data(),      cache.ys.data(),     cache.w_img.data(),
-                                cache.w_lidar.data(), cache.priors.data(), cache.texels.data()->v,
-                                cache.texel_row.data(), cache.padded,      cache.count,
-                                cache.constant};
+  if (!avx2_) {
+    buildWindowBaseline(px, py, cache);
     return;
   }
+  const KernelWindowOut out{cache.xs.data(),      cache.ys.data(),     cache.w_img.data(),
+                            cache.w_lidar.data(), cache.priors.data(), cache.texels.data()->v,
+                            cache.texel_row.data()};
+  cache.count = buildWindowAvx2(kernel_self_, px, py, out, cache.padded, cache.constant);
+  cache.kernel = KernelWindow{cache.xs.data(),      cache.ys.data(),     cache.w_img.data(),
+                              cache.w_lidar.data(), cache.priors.data(), cache.texels.data()->v,
+                              cache.texel_row.data(), cache.padded,      cache.count,
+                              cache.constant};
+}
+
+void MatchingCost::buildWindowBaseline(int px, int py, WindowCache& cache) const {
   cache.constant = 0.f;
   int k = 0;
-  const short* texels = self_.texels.data()->v;
-  const short* center = texels + (static_cast<long>(py) * self_.width + px) * kTexelChannels;
+  const short* center =
+      self_.texels.data()->v + (static_cast<long>(py) * self_.width + px) * kTexelChannels;
   const float texel_unit = 1.f / static_cast<float>(kTexelScale);  // exact: a power of two
   for (size_t i = 0; i < offsets_.size(); ++i) {
     const int y = py + offsets_[i];
@@ -177,19 +213,11 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
       cache.ys[k] = static_cast<float>(y);
       cache.texels[k] = t;
       cache.texel_row[k] = y * kTexelChannels * other_.width;
-      const float trust = use_prior_ ? trow[x] : 0.f;
       cache.priors[k] = use_prior_ ? prow[x] : 0.f;
-      if (weighted_) {
-        // phi = (1 - kappa) / (alpha + beta) rho_img + kappa rho_lid, kappa = gamma c(p').
-        const float kappa = wg_ * trust;
-        cache.w_img[k] = w * (1.f - kappa) * img_norm_;
-        cache.w_lidar[k] = w * kappa;
-      } else {
-        // The paper: phi = rho_img + gamma rho_lid, or + gamma lambda_disp without a prior.
-        cache.w_img[k] = w;
-        cache.w_lidar[k] = trust > 0.f ? w * wg_ : 0.f;
-        if (use_prior_ && !(trust > 0.f)) cache.constant += w * wg_ * ldisp_;
-      }
+      const PhiWeights phi = phiWeights(w, use_prior_ ? trow[x] : 0.f);
+      cache.w_img[k] = phi.image;
+      cache.w_lidar[k] = phi.lidar;
+      cache.constant += phi.constant;
       ++k;
     }
   }
@@ -234,6 +262,17 @@ inline float imageTerm(const KernelConstants& kc, const int* l1, bool inside) {
 /// Where sample k's plane disparity d matches in the other view, as both kernels compute it:
 /// `inside` the image, the left node's offset in the other view's texels [shorts] and the
 /// fraction in fixed point.
+/// The LiDAR term rho_lid = min(|Pi(p') - d|, lambda_disp) of a sample with prior Pi(p').
+inline float lidarTerm(float prior, float d, float lambda_disp) {
+  return std::min(std::abs(prior - d), lambda_disp);
+}
+
+/// w(p, p') phi(p', q) of window sample k from its image and LiDAR terms, with the factors of
+/// MatchingCost::phiWeights that buildWindow cached (the plane-independent part is in `constant`).
+inline float weightedPhi(const WindowCache& cache, int k, float rho_img, float rho_lid) {
+  return cache.w_img[k] * rho_img + cache.w_lidar[k] * rho_lid;
+}
+
 struct Match {
   bool inside;
   int node;
@@ -275,8 +314,8 @@ float MatchingCost::aggregateImpl(const WindowCache& cache, const Plane& plane, 
         l1[c] = std::abs(own[c] - (t0[c] + mulhrs(t0[kTexelChannels + c] - t0[c], m.frac_q)));
       }
       const float rho_img = imageTerm(kc, l1, m.inside);
-      const float rho_lid = std::min(std::abs(cache.priors[k] - d), kc.lambda_disp);
-      lanes[k - start] += cache.w_img[k] * rho_img + cache.w_lidar[k] * rho_lid;
+      const float rho_lid = lidarTerm(cache.priors[k], d, kc.lambda_disp);
+      lanes[k - start] += weightedPhi(cache, k, rho_img, rho_lid);
     }
     if ((start / kSimdBlock) % 2 == 1) {
       const float sum = cache.constant + laneSum(lanes);
@@ -312,8 +351,8 @@ void MatchingCost::aggregateSidesImpl(const WindowCache& cache, const Plane& pla
     float* lanes[2] = {lanes_lower, lanes_upper};
     for (int side = 0; side < 2; ++side) {
       const float rho_img = imageTerm(kc, l1s[side], m.inside);
-      const float rho_lid = std::min(std::abs(cache.priors[k] - dh[side]), kc.lambda_disp);
-      lanes[side][k % kSimdBlock] += cache.w_img[k] * rho_img + cache.w_lidar[k] * rho_lid;
+      const float rho_lid = lidarTerm(cache.priors[k], dh[side], kc.lambda_disp);
+      lanes[side][k % kSimdBlock] += weightedPhi(cache, k, rho_img, rho_lid);
     }
   }
   lower = cache.constant + laneSum(lanes_lower);

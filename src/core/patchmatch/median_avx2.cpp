@@ -51,7 +51,7 @@ float weightedMedianAvx2(const float* d, const float* w, int n, int padded, floa
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion
 
-#else  // no AVX2 + FMA in this build: never selected (activeSimdPath() is then kBaseline)
+#else  // no AVX2 + FMA in this build: never selected (simdPathSupported(kAvx2) is false)
 
 namespace lidar_stereo_fusion {
 namespace patchmatch {

@@ -57,7 +57,7 @@ float weightedMedianAvx512(const float* d, const float* w, int n, int padded, fl
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion
 
-#else  // no AVX-512 in this build: never selected (activeSimdPath() is then not kAvx512)
+#else  // no AVX-512 in this build: never selected (simdPathSupported(kAvx512) is false)
 
 namespace lidar_stereo_fusion {
 namespace patchmatch {

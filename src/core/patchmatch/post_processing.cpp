@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "lidar_stereo_fusion/core/patchmatch/median_kernel.h"
-#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 
 namespace lidar_stereo_fusion {
 namespace patchmatch {
@@ -78,6 +77,113 @@ cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float ma
   return bad;
 }
 
+namespace {
+
+/// Whether the view's prior fills pixel (x, y): it has a value there, trusted >= fill_trust.
+inline bool priorFills(const ViewState& v, int x, int y, float fill_trust) {
+  return v.prior(y, x) > 0.f && v.trust(y, x) >= fill_trust;
+}
+
+/// The fill's first step: where the prior is sure, the bad pixels take it and are no longer bad.
+void fillFromPrior(const ViewState& v, cv::Mat1b& bad, float fill_trust, cv::Mat1f& disparity,
+                   int threads) {
+  if (v.prior.empty()) return;
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int y = 0; y < v.height; ++y) {
+    for (int x = 0; x < v.width; ++x) {
+      if (bad(y, x) && priorFills(v, x, y, fill_trust)) {
+        disparity(y, x) = v.prior(y, x);
+        bad(y, x) = 0;
+      }
+    }
+  }
+}
+
+/// Bleyer's fill of row y: each bad pixel takes the lower (background) disparity of the planes of
+/// the nearest consistent pixels left and right, extended to it (0 where neither qualifies).
+void fillRowFromBackground(const ViewState& v, const cv::Mat1b& bad, int y, float max_disparity,
+                           float* filled) {
+  // The nearest consistent pixel to the left of each pixel, found in one pass (-1: none).
+  std::vector<int> left_good(v.width);
+  int last = -1;
+  for (int x = 0; x < v.width; ++x) {
+    left_good[x] = last;
+    if (!bad(y, x)) last = x;
+  }
+  int xr = v.width;  // the nearest consistent pixel to the right (width: none)
+  for (int x = v.width - 1; x >= 0; --x) {
+    if (!bad(y, x)) {
+      xr = x;
+      continue;
+    }
+    // A neighbour's plane extended to this pixel fills it only up to max_disparity: at the
+    // image border one side is missing, and a slanted plane extrapolated far can pass it.
+    float best = std::numeric_limits<float>::max();
+    const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+    for (const int xn : {left_good[x], xr}) {
+      if (xn < 0 || xn >= v.width) continue;
+      const float d = v.planes[y * v.width + xn].at(fx, fy);
+      if (d <= max_disparity) best = std::min(best, d);
+    }
+    filled[x] = best == std::numeric_limits<float>::max() ? 0.f : std::max(0.f, best);
+  }
+}
+
+/// The median's weights exp(-L1 colour / delta), tabulated per unit of RGB L1 distance.
+std::vector<float> colourWeightTable(float delta) {
+  std::vector<float> lut(1024);
+  for (size_t i = 0; i < lut.size(); ++i) lut[i] = std::exp(-static_cast<float>(i) / delta);
+  return lut;
+}
+
+/// The window of pixel (x, y) for its weighted median: the filled disparities > 0 on every second
+/// row and column within `radius` (the median barely changes, the cost quarters) into ds, their
+/// colour weights into ws. Returns how many; `total` is their weights' sum.
+int medianWindow(const ViewState& v, const cv::Mat1f& filled, int x, int y, int radius,
+                 const std::vector<float>& lut, float* ds, float* ws, float& total) {
+  const cv::Vec3f& c = v.color(y, x);
+  const int lut_last = static_cast<int>(lut.size()) - 1;
+  total = 0.f;
+  int n = 0;
+  for (int yy = std::max(0, y - radius); yy <= std::min(v.height - 1, y + radius); yy += 2) {
+    const float* frow = filled.ptr<float>(yy);
+    const cv::Vec3f* crow = v.color.ptr<cv::Vec3f>(yy);
+    for (int xx = std::max(0, x - radius); xx <= std::min(v.width - 1, x + radius); xx += 2) {
+      const float d = frow[xx];
+      if (d <= 0.f) continue;
+      const cv::Vec3f& q = crow[xx];
+      const int l1 = static_cast<int>(std::abs(q[0] - c[0]) + std::abs(q[1] - c[1]) +
+                                      std::abs(q[2] - c[2]));
+      const float w = lut[std::min(l1, lut_last)];
+      ds[n] = d;
+      ws[n++] = w;
+      total += w;
+    }
+  }
+  return n;
+}
+
+/// The fill's last step: each bad pixel takes the colour-weighted median of `filled` over its
+/// window (medianWindow); a window without any fill leaves the pixel as it is.
+void weightedMedianFilter(const ViewState& v, const cv::Mat1b& bad, const cv::Mat1f& filled,
+                          const FillOptions& o, cv::Mat1f& disparity, int threads) {
+  const std::vector<float> lut = colourWeightTable(o.delta);
+#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
+  for (int y = 0; y < v.height; ++y) {
+    // At most radius + 1 samples per axis (every second of 2 radius + 1), and the padding.
+    const int most = (o.radius + 1) * (o.radius + 1);
+    std::vector<float> ds(most + kMedianLanes), ws(most + kMedianLanes);
+    for (int x = 0; x < v.width; ++x) {
+      if (!bad(y, x)) continue;
+      float total;
+      const int n = medianWindow(v, filled, x, y, o.radius, lut, ds.data(), ws.data(), total);
+      if (n > 0) disparity(y, x) = weightedMedian(ds.data(), ws.data(), n, 0.5f * total, o.simd);
+    }
+  }
+}
+
+}  // namespace
+
 void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, int scale,
                    float fill_trust, cv::Mat1f& disparity, int threads) {
   const bool has_prior = !v.prior.empty();
@@ -87,7 +193,7 @@ void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, in
     const float* below_row = below[std::min(below.rows - 1, y / scale)];
     for (int x = 0; x < disparity.cols; ++x) {
       if (!bad(y, x)) continue;
-      if (has_prior && v.prior(y, x) > 0.f && v.trust(y, x) >= fill_trust) {
+      if (has_prior && priorFills(v, x, y, fill_trust)) {
         disparity(y, x) = v.prior(y, x);
         bad(y, x) = 0;
       } else {
@@ -97,83 +203,16 @@ void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, in
   }
 }
 
-void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float fill_trust,
-               float max_disparity, cv::Mat1f& disparity, int threads) {
-  if (!v.prior.empty()) {
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (int y = 0; y < v.height; ++y) {
-      for (int x = 0; x < v.width; ++x) {
-        if (bad(y, x) && v.prior(y, x) > 0.f && v.trust(y, x) >= fill_trust) {
-          disparity(y, x) = v.prior(y, x);
-          bad(y, x) = 0;
-        }
-      }
-    }
-  }
+void fillHoles(const ViewState& v, cv::Mat1b bad, const FillOptions& options,
+               cv::Mat1f& disparity, int threads) {
+  fillFromPrior(v, bad, options.fill_trust, disparity, threads);
   cv::Mat1f filled = disparity.clone();
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
   for (int y = 0; y < v.height; ++y) {
-    // The nearest consistent pixel to the left of each pixel, found in one pass (-1: none).
-    std::vector<int> left_good(v.width);
-    int last = -1;
-    for (int x = 0; x < v.width; ++x) {
-      left_good[x] = last;
-      if (!bad(y, x)) last = x;
-    }
-    int xr = v.width;  // the nearest consistent pixel to the right (width: none)
-    for (int x = v.width - 1; x >= 0; --x) {
-      if (!bad(y, x)) {
-        xr = x;
-        continue;
-      }
-      // A neighbour's plane extended to this pixel fills it only up to max_disparity: at the
-      // image border one side is missing, and a slanted plane extrapolated far can pass it.
-      float best = std::numeric_limits<float>::max();
-      const int xl = left_good[x];
-      const float fx = static_cast<float>(x), fy = static_cast<float>(y);
-      for (const int xn : {xl, xr}) {
-        if (xn < 0 || xn >= v.width) continue;
-        const float d = v.planes[y * v.width + xn].at(fx, fy);
-        if (d <= max_disparity) best = std::min(best, d);
-      }
-      filled(y, x) = best == std::numeric_limits<float>::max() ? 0.f : std::max(0.f, best);
-    }
+    fillRowFromBackground(v, bad, y, options.max_disparity, filled[y]);
   }
-  // Weighted median over the window of each filled pixel (weights exp(-L1 colour / delta)).
-  std::vector<float> lut(1024);
-  for (size_t i = 0; i < lut.size(); ++i) lut[i] = std::exp(-static_cast<float>(i) / delta);
   filled.copyTo(disparity);  // same size: no new allocation
-  const int lut_last = static_cast<int>(lut.size()) - 1;
-  const SimdPath path = activeSimdPath();
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-  for (int y = 0; y < v.height; ++y) {
-    // At most radius + 1 samples per axis (every second of 2 radius + 1), and the padding.
-    const int most = (radius + 1) * (radius + 1);
-    std::vector<float> ds(most + kMedianLanes), ws(most + kMedianLanes);
-    for (int x = 0; x < v.width; ++x) {
-      if (!bad(y, x)) continue;
-      const cv::Vec3f& c = v.color(y, x);
-      float total = 0.f;
-      int n = 0;
-      // Every second row and column of the window: the median barely changes, the cost quarters.
-      for (int yy = std::max(0, y - radius); yy <= std::min(v.height - 1, y + radius); yy += 2) {
-        const float* frow = filled.ptr<float>(yy);
-        const cv::Vec3f* crow = v.color.ptr<cv::Vec3f>(yy);
-        for (int xx = std::max(0, x - radius); xx <= std::min(v.width - 1, x + radius); xx += 2) {
-          const float d = frow[xx];
-          if (d <= 0.f) continue;
-          const cv::Vec3f& q = crow[xx];
-          const int l1 = static_cast<int>(std::abs(q[0] - c[0]) + std::abs(q[1] - c[1]) +
-                                          std::abs(q[2] - c[2]));
-          const float w = lut[std::min(l1, lut_last)];
-          ds[n] = d;
-          ws[n++] = w;
-          total += w;
-        }
-      }
-      if (n > 0) disparity(y, x) = weightedMedian(ds.data(), ws.data(), n, 0.5f * total, path);
-    }
-  }
+  weightedMedianFilter(v, bad, filled, options, disparity, threads);
 }
 
 }  // namespace patchmatch

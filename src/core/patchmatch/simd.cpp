@@ -1,11 +1,6 @@
-// PatchMatch: runtime selection of the cost kernel (see simd.h).
+// PatchMatch: what the CPU runs of the cost kernels (see simd.h). No state beyond the CPU's
+// features, detected once.
 #include "lidar_stereo_fusion/core/patchmatch/simd.h"
-
-#include <atomic>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <stdexcept>
 
 #include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
 
@@ -35,32 +30,6 @@ bool detectAvx512() {
 #endif
 }
 
-SimdPath widestPath() {
-  if (cpuHasAvx512()) return SimdPath::kAvx512;
-  return cpuHasAvx2Fma() ? SimdPath::kAvx2 : SimdPath::kBaseline;
-}
-
-/// The path at start-up: the widest the CPU runs, capped by LSF_SIMD (baseline, avx2).
-SimdPath initialPath() {
-  const SimdPath widest = widestPath();
-  const char* env = std::getenv("LSF_SIMD");
-  if (env == nullptr || *env == '\0') return widest;
-  if (std::strcmp(env, "baseline") == 0) return SimdPath::kBaseline;
-  if (std::strcmp(env, "avx2") == 0) {
-    return widest == SimdPath::kBaseline ? SimdPath::kBaseline : SimdPath::kAvx2;
-  }
-  if (std::strcmp(env, "avx512") != 0) {
-    std::fprintf(stderr, "lidar_stereo_fusion: LSF_SIMD=%s is not baseline, avx2 or avx512; "
-                 "using the widest path this CPU runs\n", env);
-  }
-  return widest;
-}
-
-std::atomic<int>& pathStore() {
-  static std::atomic<int> path(static_cast<int>(initialPath()));
-  return path;
-}
-
 }  // namespace
 
 bool cpuHasAvx2Fma() {
@@ -85,10 +54,18 @@ bool simdPathSupported(SimdPath path) {
   return false;
 }
 
-SimdPath activeSimdPath() { return static_cast<SimdPath>(pathStore().load()); }
+SimdPath widestSimdPath() {
+  if (cpuHasAvx512()) return SimdPath::kAvx512;
+  return cpuHasAvx2Fma() ? SimdPath::kAvx2 : SimdPath::kBaseline;
+}
 
-const char* simdLevel() {
-  switch (activeSimdPath()) {
+SimdPath capSimdPath(SimdPath requested) {
+  const SimdPath widest = widestSimdPath();
+  return static_cast<int>(requested) < static_cast<int>(widest) ? requested : widest;
+}
+
+const char* simdPathName(SimdPath path) {
+  switch (path) {
     case SimdPath::kAvx512:
       return "avx512";
     case SimdPath::kAvx2:
@@ -99,13 +76,14 @@ const char* simdLevel() {
   return "baseline";
 }
 
-void setSimdPath(SimdPath path) {
-  if (!simdPathSupported(path)) {
-    throw std::invalid_argument(path == SimdPath::kAvx512
-                                    ? "setSimdPath: this CPU (or build) has no AVX-512"
-                                    : "setSimdPath: this CPU (or build) has no AVX2 + FMA");
+bool parseSimdPath(const std::string& name, SimdPath& path) {
+  for (const SimdPath p : {SimdPath::kBaseline, SimdPath::kAvx2, SimdPath::kAvx512}) {
+    if (name == simdPathName(p)) {
+      path = p;
+      return true;
+    }
   }
-  pathStore().store(static_cast<int>(path));
+  return false;
 }
 
 }  // namespace lidar_stereo_fusion

@@ -64,10 +64,18 @@ struct WindowRows {
 };
 WindowRows windowRows(const std::vector<int>& offsets, int radius, bool round);
 
+/// The factors of phi for one window sample (the support weight w(p, p') folded in): the sample
+/// costs w phi = image rho_img + lidar rho_lid + constant (see the two readings of phi above).
+struct PhiWeights {
+  float image;     ///< w times rho_img's factor
+  float lidar;     ///< w times rho_lid's factor (0: no prior)
+  float constant;  ///< the plane-independent part (the paper: gamma lambda_disp without a prior)
+};
+
 class MatchingCost {
  public:
-  /// Uses the AVX2 kernels when activeSimdPath() is kAvx2, and the AVX-512 cost with the AVX2
-  /// window when it is kAvx512.
+  /// Uses the AVX2 kernels when params.simd_path is kAvx2, and the AVX-512 cost with the AVX2
+  /// window when it is kAvx512. Keeps references to `params` and the views: they must outlive it.
   MatchingCost(const PatchMatchParams& params, const ViewState& self, const ViewState& other);
 
   /// w(p, p') for an RGB L1 distance [0, 765].
@@ -91,6 +99,10 @@ class MatchingCost {
   void aggregateSides(const WindowCache& cache, const Plane& plane, float h, float& lower,
                       float& upper) const;
 
+  /// phi's factors for a sample of support weight `w` whose prior has confidence `trust` (0: no
+  /// prior), as the windows cache them (the SIMD window builders compute the same).
+  PhiWeights phiWeights(float w, float trust) const;
+
   /// Whether this cost runs the AVX2 kernel.
   bool usesAvx2() const { return avx2_; }
 
@@ -101,6 +113,15 @@ class MatchingCost {
   const WindowRows& rows() const { return rows_; }
 
  private:
+  // The constructor's steps: the table of w, the weights of phi, the window inside the image,
+  // and the SIMD kernels' views of them (cost_kernel.h).
+  void tabulateSupportWeight();
+  void readCostWeights();
+  void buildInteriorWindow();
+  KernelSelf kernelSelf() const;
+  KernelConstants kernelConstants() const;
+
+  void buildWindowBaseline(int px, int py, WindowCache& cache) const;
   float aggregateImpl(const WindowCache& cache, const Plane& plane, float bound) const;
   void aggregateSidesImpl(const WindowCache& cache, const Plane& plane, float h, int shift_q,
                           float& lower, float& upper) const;

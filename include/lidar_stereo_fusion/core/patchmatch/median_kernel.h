@@ -1,6 +1,6 @@
 // PatchMatch hole filling: the plain-data interface of the AVX2 and AVX-512 weighted-median
 // kernels (median_avx2.cpp, median_avx512.cpp), under cost_kernel.h's rules: this header includes
-// nothing, and each kernel runs only where activeSimdPath() allows it (each is built with the
+// nothing, and each kernel runs only where the SimdPath it is given allows it (built with the
 // matching cost kernel's flags).
 #pragma once
 

@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/patchmatch/view_state.h"
 
 namespace lidar_stereo_fusion {
@@ -30,14 +31,24 @@ cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float ma
 void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, int scale,
                    float fill_trust, cv::Mat1f& disparity, int threads = 1);
 
-/// Fills the pixels marked in `bad` (modified). Where the view's prior has a value and its trust
-/// is >= fill_trust, the prior fills the hole (the LiDAR saw the point: our reading for the fused
-/// method; Bleyer's background fill assumes no other source). Elsewhere the lower (background)
-/// disparity of the nearest consistent planes left and right (of those not above max_disparity,
-/// the configured search range, at the pixel), then a colour-weighted median over
+/// How fillHoles fills (PatchMatchParams' median_radius, weight_delta, fill_confidence,
+/// max_disparity and simd_path).
+struct FillOptions {
+  int radius;           ///< half window of the weighted median [px]
+  float delta;          ///< its colour weights exp(-L1 colour / delta)
+  float fill_trust;     ///< the prior fills where its trust is >= this
+  float max_disparity;  ///< the search range [px]: no fill above it
+  SimdPath simd;        ///< the median kernel's instructions (same result on every path)
+};
+
+/// Fills the pixels marked in `bad` (modified), in three steps. Where the view's prior has a value
+/// and its trust is >= fill_trust, the prior fills the hole (the LiDAR saw the point: our reading
+/// for the fused method; Bleyer's background fill assumes no other source). Elsewhere the lower
+/// (background) disparity of the nearest consistent planes left and right (of those not above
+/// max_disparity, the configured search range, at the pixel), then a colour-weighted median over
 /// the window of radius `radius` (every second row and column; weights exp(-L1 colour / delta)).
-void fillHoles(const ViewState& v, cv::Mat1b bad, int radius, float delta, float fill_trust,
-               float max_disparity, cv::Mat1f& disparity, int threads);
+void fillHoles(const ViewState& v, cv::Mat1b bad, const FillOptions& options,
+               cv::Mat1f& disparity, int threads);
 
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion

@@ -2,11 +2,13 @@
 //
 // The binary is built for baseline x86-64; the cost kernel also exists as an AVX2 + FMA version
 // (cost_avx2.cpp, built with -mavx2 -mfma) and AVX-512 versions of its aggregation and of the
-// fill's weighted median (*_avx512.cpp, F + BW + VL + DQ), chosen at run time: the widest the CPU
-// (and the operating system) supports. All paths give bit-identical results. The environment
-// variable LSF_SIMD (read once, at the first use) caps it: `baseline` or `avx2`; setSimdPath()
-// switches paths in-process (tests, benchmarks).
+// fill's weighted median (*_avx512.cpp, F + BW + VL + DQ). All paths give bit-identical results.
+// The path is a value each computation is given (PatchMatchParams::simd_path, by default the
+// widest this CPU runs); the core keeps no process-wide choice and reads no environment. Tools
+// and the nodelet may take it from the environment variable LSF_SIMD (io/simd_env.h).
 #pragma once
+
+#include <string>
 
 namespace lidar_stereo_fusion {
 
@@ -23,15 +25,16 @@ bool cpuHasAvx512();
 /// Whether this CPU and build can run `path`.
 bool simdPathSupported(SimdPath path);
 
-/// The path the matching cost uses: the widest supported one, unless LSF_SIMD or setSimdPath()
-/// chose otherwise.
-SimdPath activeSimdPath();
+/// The widest path this CPU and build run (PatchMatchParams' default).
+SimdPath widestSimdPath();
 
-/// Name of the active path: "avx512", "avx2" or "baseline" (for tool headers and logs).
-const char* simdLevel();
+/// `requested`, narrowed to the widest path this CPU and build run.
+SimdPath capSimdPath(SimdPath requested);
 
-/// Selects the path for PatchMatch computations started afterwards (not while one runs).
-/// Throws std::invalid_argument for a path !simdPathSupported().
-void setSimdPath(SimdPath path);
+/// Name of a path: "avx512", "avx2" or "baseline" (for tool headers and logs).
+const char* simdPathName(SimdPath path);
+
+/// Parses a name of simdPathName(); false (and `path` untouched) for anything else.
+bool parseSimdPath(const std::string& name, SimdPath& path);
 
 }  // namespace lidar_stereo_fusion
