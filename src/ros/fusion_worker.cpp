@@ -37,7 +37,7 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
       pnh_(pnh),
       name_(name),
       node_params_(NodeParams::read(pnh)),
-      log_(name),
+      log_(name, node_params_.log_throttle_period),
       gate_(nh, pnh, node_params_, counters_, log_),
       outputs_(nh, pnh, name, node_params_, counters_, gate_),
       tf_listener_(tf_buffer_) {
