@@ -32,9 +32,8 @@ constexpr double kOutputTimeout = 20.0;  ///< [s] first frame includes pipeline 
 
 /// The output topics, relative to the fusion namespace.
 const std::vector<std::string> kOutputs = {
-    "disparity",         "depth/image_rect", "depth/camera_info",
-    "depth/image_color", "points2",          "lidar_disparity",
-    "disparity_image",   "disparity_image_color", "confidence", "stats"};
+    "disparity",       "depth/image_rect", "depth/camera_info",     "depth/image_color", "points2",
+    "lidar_disparity", "disparity_image",  "disparity_image_color", "confidence",        "stats"};
 
 /// How one input set is made.
 struct SetSpec {

@@ -807,17 +807,16 @@ TEST_F(FusionNode, InvalidPointsOfAValidSweepAreCounted) {
                                          spec.custom_cloud->fields[field].offset],
                 &value, sizeof(float));
   };
-  put(0, 0, 1e38f);                                          // x = 1e38
-  put(1, 2, std::numeric_limits<float>::infinity());         // z = inf
-  put(2, 1, std::numeric_limits<float>::quiet_NaN());        // y = NaN
+  put(0, 0, 1e38f);                                    // x = 1e38
+  put(1, 2, std::numeric_limits<float>::infinity());   // z = inf
+  put(2, 1, std::numeric_limits<float>::quiet_NaN());  // y = NaN
   const ros::Time stamp = h().nextStamp();
   h().publishSet(spec, stamp);
   ASSERT_TRUE(h().waitForOutputs(stamp));
   ASSERT_TRUE(h().stats());
   EXPECT_EQ(h().stats()->header.stamp, stamp);
   EXPECT_EQ(h().stats()->points_invalid, 3);
-  EXPECT_EQ(h().stats()->points_in_cloud,
-            static_cast<int>(base->width * base->height) - 3);
+  EXPECT_EQ(h().stats()->points_in_cloud, static_cast<int>(base->width * base->height) - 3);
 }
 
 int main(int argc, char** argv) {
