@@ -107,7 +107,7 @@ class FusionNode : public FusionNodeUnsubscribed {
       h().publishSet(spec, sent.back());
       return Harness::waitFor(2.0, [&] {
         for (const auto& stamp : sent) {
-          if (h().outputsSoFar(stamp) == static_cast<int>(kOutputs.size())) out = stamp;
+          if (h().waitForOutputs(stamp, 0.0)) out = stamp;
         }
         return !out.isZero();
       });
