@@ -172,7 +172,7 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
     ++counters_.tf_failures;
     log_.warn(kCloud, "tf",
               "no transform from '" + lidar_frame + "' (" + topicName(kCloud) + ") to '" +
-                  camera_frame + "' (" + topicName(kLeftImage) + ") at " +
+                  camera_frame + "' (" + topicName(kLeftImage) + ") at stamp " +
                   stampText(extrinsics_stamp) + " within " +
                   std::to_string(node_params_.tf_timeout) + " s: " + e.what() + "; frame skipped");
     return;

@@ -102,6 +102,14 @@ class Harness {
     return last_stamp_;
   }
 
+  /// nextStamp() once the clock has reached it (sets sent in a burst run ahead of it), for a test
+  /// that checks the latency (publish time - stamp) of its sets. Waits at most 10 s.
+  ros::Time nextStampNotAhead() {
+    const ros::Time stamp = nextStamp();
+    waitFor(10.0, [&] { return ros::Time::now() >= stamp; });
+    return stamp;
+  }
+
   sensor_msgs::PointCloud2Ptr makeCloud(const SetSpec& spec, const ros::Time& stamp) const {
     const auto& frame = frames_[spec.frame % frames_.size()];
     const ros::Time cloud_stamp = stamp + ros::Duration(spec.cloud_offset);

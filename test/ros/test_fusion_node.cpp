@@ -211,8 +211,8 @@ TEST_F(FusionNode, OneOutputPerInputSetOnEveryTopic) {
     SetSpec spec;
     spec.frame = static_cast<int>(i);
     spec.left_encoding = spec.right_encoding = encodings[i];
-    spec.positive_tx = (i == 1);  // both sign conventions of the right P[3]
-    const ros::Time stamp = h().nextStamp();
+    spec.positive_tx = (i == 1);                      // both sign conventions of the right P[3]
+    const ros::Time stamp = h().nextStampNotAhead();  // latency_ms > 0 below
     stamps.push_back(stamp);
     h().publishSet(spec, stamp);
     ASSERT_TRUE(h().waitForOutputs(stamp)) << "no complete output for " << encodings[i];
