@@ -9,7 +9,8 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   namespace lsf = lidar_stereo_fusion;
   try {
-    const auto calib = lsf::readAutowareCalibration(lsf_fuzz::writeFile("autoware.yaml", data, size));
+    const auto calib =
+        lsf::readAutowareCalibration(lsf_fuzz::writeFile("autoware.yaml", data, size));
     lsf::cameraFromLidar(calib);
     lsf::meanReprojectionError(calib);
   } catch (const std::exception&) {  // a rejection; crashes and sanitizer reports are findings

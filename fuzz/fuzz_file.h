@@ -14,7 +14,8 @@ namespace lsf_fuzz {
 /// <tmp>/lsf_fuzz_<pid>/, created once.
 inline const std::filesystem::path& scratch() {
   static const std::filesystem::path dir = [] {
-    const auto d = std::filesystem::temp_directory_path() / ("lsf_fuzz_" + std::to_string(getpid()));
+    const auto d =
+        std::filesystem::temp_directory_path() / ("lsf_fuzz_" + std::to_string(getpid()));
     std::filesystem::create_directories(d);
     return d;
   }();

@@ -2,8 +2,8 @@
 // the rest of the input; the other is a valid one. Exceptions are rejections.
 #include <cstddef>
 #include <cstdint>
-#include <fstream>
 #include <exception>
+#include <fstream>
 
 #include "fuzz_file.h"
 #include "lidar_stereo_fusion/io/kitti.h"

@@ -23,8 +23,8 @@ inline const std::vector<std::string>& fieldNames() {
   // The per-point time fields of the common drivers (conversions::PointTimeField) included;
   // "other" stays last (encodeCloud writes it for any name not listed).
   static const std::vector<std::string> kNames = {
-      "x",         "y",        "z",         "intensity", "ring", "time", "t", "offset_time",
-      "timestamp", "time_sec", "time_nsec", "rgb",       "other"};
+      "x",           "y",         "z",        "intensity", "ring", "time", "t",
+      "offset_time", "timestamp", "time_sec", "time_nsec", "rgb",  "other"};
   return kNames;
 }
 inline const std::vector<std::string>& encodings() {
@@ -60,7 +60,8 @@ class ByteWriter {
  public:
   template <class T>
   void put(T value) {
-    for (std::size_t i = 0; i < sizeof(T); ++i) bytes.push_back(static_cast<uint8_t>(value >> (8 * i)));
+    for (std::size_t i = 0; i < sizeof(T); ++i)
+      bytes.push_back(static_cast<uint8_t>(value >> (8 * i)));
   }
   std::vector<uint8_t> bytes;
 };

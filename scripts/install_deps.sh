@@ -17,7 +17,7 @@ PKGS=(
   libgtest-dev libopencv-dev libeigen3-dev libyaml-cpp-dev
   python3-roslaunch ros-message-generation ros-message-runtime
   xvfb imagemagick rviz rosbash python3-sensor-msgs python3-stereo-msgs
-  clang libclang-rt-14-dev libomp-dev
+  clang libclang-rt-14-dev libomp-dev clang-format-14
   python3-distributed python3-dask python3-psutil python3-pytest
 )
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds the package in a catkin workspace and runs every test:
-# core gtests (exact synthetic answers), data gtests (../shared/data), rostests (node, nodelet,
+# Installs what is missing, checks the C++ formatting (scripts/check_format.sh: clang-format 14 and
+# .clang-format; a diff fails the run after the tests), builds the package in a catkin workspace
+# and runs every test: core gtests (exact synthetic answers), data gtests (../shared/data), rostests (node, nodelet,
 # calibration, KITTI bag playback at several rates, RViz), the launch-file check, and then each
 # libFuzzer target of fuzz/ for a bounded time (scripts/run_fuzz.sh).
 # Usage: bash scripts/run_tests.sh            (from anywhere; the workspace goes to ./ws)
@@ -17,6 +18,10 @@ DATA=${LSF_DATA_DIR:-$(cd "$ROOT/.." && pwd)/shared/data}
 JOBS=${LSF_JOBS:-2}
 
 bash "$ROOT/scripts/install_deps.sh"
+
+echo "== format (clang-format 14, .clang-format)"
+format_status=0
+bash "$ROOT/scripts/check_format.sh" || format_status=$?
 
 # Debian's ROS uses the system Python; a pyenv python3 first on PATH breaks catkin.
 export PATH=/usr/bin:/bin:$PATH
@@ -74,5 +79,9 @@ fi
 if [ $fuzz_status -ne 0 ]; then
   echo "fuzzing found a problem (see above)" >&2
   exit $fuzz_status
+fi
+if [ $format_status -ne 0 ]; then
+  echo "C++ sources differ from clang-format's format (see '== format' above)" >&2
+  exit $format_status
 fi
 exit $summary_status

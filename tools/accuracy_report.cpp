@@ -58,7 +58,8 @@ std::string defaultDataDir() {
 }
 
 Options parseOptions(int argc, char** argv) {
-  const lsf::CommandLine cl(argc, argv, {"--data", "--protocols", "--frames", "--params", "--methods"},
+  const lsf::CommandLine cl(argc, argv,
+                            {"--data", "--protocols", "--frames", "--params", "--methods"},
                             {"--no-kitti-pms", "--help"});
   Options o;
   o.help = cl.has("--help");

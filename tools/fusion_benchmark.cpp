@@ -1,7 +1,8 @@
 // fusion_benchmark: wall time of every stage of the fusion on one frame (KITTI raw or the
 // synthetic street at any size and ring count), beside OpenCV's StereoSGBM on the same pair in
 // the same run: median over N repetitions after a warm-up, fused and SGBM alternating so that both
-// see the same machine.
+// see the same machine. Then the LiDAR stages alone (ring recovery, projection, BI*, BF*) on the
+// left view, which the pipeline's rows sum over both views.
 #include <omp.h>
 
 #include <chrono>
@@ -15,7 +16,10 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "lidar_stereo_fusion/core/lidar_projection.h"
+#include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/core/upsampling.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
@@ -34,7 +38,8 @@ const char* const kUsage = R"(Usage: fusion_benchmark [options]
 Times every stage of the fusion on one frame and OpenCV's StereoSGBM (MODE_SGBM_3WAY, 128
 disparities, block 5, the same thread count) on the same pair, alternating, after one warm-up
 run of each; prints the median [ms] per stage, SGBM's median and the ratio fused / SGBM (median
-of the per-repetition ratios).
+of the per-repetition ratios); then the LiDAR stages alone on the left view (ring recovery by
+sweep order, projection, BI* and BF* up-sampling), median [ms] each.
 
 Options:
   --kitti-raw <dir>  the KITTI drive (default: the shared data's drive 0009, found from the
@@ -179,6 +184,31 @@ void printStages(const Timing& t) {
   std::printf("%.2f frames/s (pipeline median %.1f ms)\n", 1000.0 / total, total);
 }
 
+/// The LiDAR stages alone on the left view, median wall time [ms] of `repeat` runs each (was the
+/// data test TimingOfProjectionAndUpsampling; the aim: projection + BI* < 30 ms, BF* well under
+/// 100 ms on KITTI).
+void printLidarStages(const Case& c, const lsf::FusionParams& params, int repeat) {
+  std::vector<double> rings, projection, bi, bf;
+  for (int i = 0; i < repeat; ++i) {
+    lsf::LidarCloud cloud = c.input.cloud;
+    rings.push_back(timeMs([&] { lsf::recoverRingsBySweepOrder(cloud); }));
+    lsf::SparseDisparity sparse;
+    projection.push_back(timeMs([&] {
+      sparse = lsf::projectCloud(cloud, c.input.T_cam_lidar, c.input.camera, params.projection);
+    }));
+    bi.push_back(timeMs([&] { lsf::upsampleBI(sparse, c.input.left, params.bi); }));
+    bf.push_back(timeMs([&] { lsf::upsampleBF(sparse, params.bf); }));
+  }
+  std::vector<double> projection_bi;
+  for (int i = 0; i < repeat; ++i) projection_bi.push_back(projection[i] + bi[i]);
+  std::printf("\n| %-38s | %9s |\n|---|---|\n", "LiDAR stage alone, left view (median)", "ms");
+  printRow("ring recovery by sweep order", lsf::median(rings));
+  printRow("projection", lsf::median(projection));
+  printRow("BI* up-sampling", lsf::median(bi));
+  printRow("projection + BI*", lsf::median(projection_bi));
+  printRow("BF* up-sampling", lsf::median(bf));
+}
+
 int run(const Options& o) {
   lsf::FusionParams params;
   if (!o.params.empty()) lsf::loadParamsYaml(o.params, params);
@@ -207,6 +237,7 @@ int run(const Options& o) {
   lsf::FusionPipeline pipeline(params);
   if (cases.size() == 1) {
     printStages(timeCase(cases.front(), pipeline, sgbm.get(), o.repeat));
+    printLidarStages(cases.front(), params, o.repeat);
     return 0;
   }
   std::printf(

@@ -30,7 +30,8 @@ double coverage(const cv::Mat1f& m) {
 
 void checkInput(const FusionInput& in) {
   in.camera.validate();
-  if (in.left.empty() || in.right.empty()) throw std::invalid_argument("left or right image is empty");
+  if (in.left.empty() || in.right.empty())
+    throw std::invalid_argument("left or right image is empty");
   if (in.left.size() != in.right.size()) {
     throw std::invalid_argument("left and right images differ in size");
   }
@@ -56,7 +57,9 @@ struct ViewPrior {
   ScanLineBounds bounds;
   int removed = 0;
 
-  ViewInput input(const cv::Mat& image) const { return ViewInput{image, prior, bounds, confidence}; }
+  ViewInput input(const cv::Mat& image) const {
+    return ViewInput{image, prior, bounds, confidence};
+  }
 };
 
 ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
@@ -81,11 +84,16 @@ int viewThreads(const FusionParams& p) { return p.patchmatch.num_threads != 1 ? 
 
 std::string methodName(Method method) {
   switch (method) {
-    case Method::kFusedBI: return "fused_bi";
-    case Method::kFusedBF: return "fused_bf";
-    case Method::kPlainPMS: return "pms";
-    case Method::kLidarBI: return "lidar_bi";
-    case Method::kLidarBF: return "lidar_bf";
+    case Method::kFusedBI:
+      return "fused_bi";
+    case Method::kFusedBF:
+      return "fused_bf";
+    case Method::kPlainPMS:
+      return "pms";
+    case Method::kLidarBI:
+      return "lidar_bi";
+    case Method::kLidarBF:
+      return "lidar_bf";
   }
   return "unknown";
 }
@@ -151,9 +159,9 @@ FusionResult FusionPipeline::process(const FusionInput& input) {
     out = projectCloud(input.cloud, input.T_cam_lidar, input.camera, params_.projection, view);
   };
   if (isFused(method)) {
-    bothViews(viewThreads(params_),
-              [&] { project(View::kLeft, left_sparse); },
-              [&] { project(View::kRight, right_sparse); });
+    bothViews(
+        viewThreads(params_), [&] { project(View::kLeft, left_sparse); },
+        [&] { project(View::kRight, right_sparse); });
   } else {
     project(View::kLeft, left_sparse);
   }

@@ -340,8 +340,7 @@ cv::Mat1f interpolateBetweenScanLines(const ScanLines& lines, const BIParams& pa
 }
 
 cv::Mat1f upsampleBI(const SparseDisparity& sparse, const cv::Mat& image, const BIParams& params,
-                     int* removed, ScanLines* lines_out,
-                     std::vector<cv::Point>* removed_pixels) {
+                     int* removed, ScanLines* lines_out, std::vector<cv::Point>* removed_pixels) {
   ScanLines lines = completeScanLines(sparse, params);
   const int count = removeOccludedPoints(lines, image, params, removed_pixels);
   if (removed) *removed = count;

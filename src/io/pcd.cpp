@@ -87,8 +87,8 @@ void parseViewpoint(const std::string& path, const std::vector<std::string>& val
 /// Reads one header line's key and values into `header`; true at DATA. PCL's reader stops at
 /// the first line it does not know and then reads the file without POINTS (it crashed on such a
 /// file, found by fuzzing): every line must be one it knows, a comment or empty.
-bool parseHeaderLine(const std::string& path, const std::vector<std::string>& words,
-                     Header& header, bool& have_points) {
+bool parseHeaderLine(const std::string& path, const std::vector<std::string>& words, Header& header,
+                     bool& have_points) {
   const std::string& key = words[0];
   const std::vector<std::string> values(words.begin() + 1, words.end());
   if (key == "VERSION") {
@@ -121,7 +121,8 @@ bool parseHeaderLine(const std::string& path, const std::vector<std::string>& wo
     header.data = values.empty() ? "" : values[0];
     return true;
   } else {
-    fail(path, "header has an unknown line '" + key + " ...' (a PCD header holds VERSION, "
+    fail(path, "header has an unknown line '" + key +
+                   " ...' (a PCD header holds VERSION, "
                    "FIELDS, SIZE, TYPE, COUNT, WIDTH, HEIGHT, VIEWPOINT, POINTS, DATA)");
   }
   return false;

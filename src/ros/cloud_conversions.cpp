@@ -43,15 +43,24 @@ int datatypeSize(uint8_t datatype) {
 
 const char* datatypeName(uint8_t datatype) {
   switch (datatype) {
-    case PointField::INT8: return "INT8";
-    case PointField::UINT8: return "UINT8";
-    case PointField::INT16: return "INT16";
-    case PointField::UINT16: return "UINT16";
-    case PointField::INT32: return "INT32";
-    case PointField::UINT32: return "UINT32";
-    case PointField::FLOAT32: return "FLOAT32";
-    case PointField::FLOAT64: return "FLOAT64";
-    default: return "unknown";
+    case PointField::INT8:
+      return "INT8";
+    case PointField::UINT8:
+      return "UINT8";
+    case PointField::INT16:
+      return "INT16";
+    case PointField::UINT16:
+      return "UINT16";
+    case PointField::INT32:
+      return "INT32";
+    case PointField::UINT32:
+      return "UINT32";
+    case PointField::FLOAT32:
+      return "FLOAT32";
+    case PointField::FLOAT64:
+      return "FLOAT64";
+    default:
+      return "unknown";
   }
 }
 
@@ -135,7 +144,7 @@ TimeLayout findTimeLayout(const sensor_msgs::PointCloud2& msg) {
   layout.value = findField(msg, "time_sec");
   layout.nanoseconds = findField(msg, "time_nsec");
   layout.field = layout.value.present && layout.nanoseconds.present ? PointTimeField::kTimeSecNsec
-                                                                     : PointTimeField::kNone;
+                                                                    : PointTimeField::kNone;
   return layout;
 }
 
@@ -162,14 +171,14 @@ double pointTime(const uint8_t* p, const TimeLayout& layout, const ros::Time& st
   return 0.0;
 }
 
-
 }  // namespace
 
 std::string checkCloudFieldTypes(const sensor_msgs::PointCloud2& msg) {
   std::ostringstream problem;
   for (const auto& f : msg.fields) {
     const bool coordinate = f.name == "x" || f.name == "y" || f.name == "z";
-    const bool read = coordinate || f.name == "intensity" || f.name == "ring" || isTimeField(f.name);
+    const bool read =
+        coordinate || f.name == "intensity" || f.name == "ring" || isTimeField(f.name);
     if (!read) continue;
     if (datatypeSize(f.datatype) == 0) {
       problem << "field '" << f.name << "' has unknown datatype " << static_cast<int>(f.datatype);
@@ -233,12 +242,18 @@ std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg) {
 
 const char* pointTimeFieldName(PointTimeField field) {
   switch (field) {
-    case PointTimeField::kTime: return "time";
-    case PointTimeField::kT: return "t";
-    case PointTimeField::kOffsetTime: return "offset_time";
-    case PointTimeField::kTimestamp: return "timestamp";
-    case PointTimeField::kTimeSecNsec: return "time_sec + time_nsec";
-    case PointTimeField::kNone: break;
+    case PointTimeField::kTime:
+      return "time";
+    case PointTimeField::kT:
+      return "t";
+    case PointTimeField::kOffsetTime:
+      return "offset_time";
+    case PointTimeField::kTimestamp:
+      return "timestamp";
+    case PointTimeField::kTimeSecNsec:
+      return "time_sec + time_nsec";
+    case PointTimeField::kNone:
+      break;
   }
   return "none";
 }

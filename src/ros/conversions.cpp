@@ -130,9 +130,9 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
     }
   }
   if (Pl[0] <= 0.0 || Pl[5] <= 0.0) {
-    throw CameraInfoError(true, "left camera_info: P has no focal length (fx = " +
-                                    std::to_string(Pl[0]) + ", fy = " + std::to_string(Pl[5]) +
-                                    "); is the camera calibrated?");
+    throw CameraInfoError(true,
+                          "left camera_info: P has no focal length (fx = " + std::to_string(Pl[0]) +
+                              ", fy = " + std::to_string(Pl[5]) + "); is the camera calibrated?");
   }
   if (Pr[0] <= 0.0) {
     throw CameraInfoError(false, "right camera_info: P has no focal length (fx = " +
@@ -140,13 +140,14 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
   }
   if (std::abs(Pl[0] - Pr[0]) > 1e-3 * Pl[0] || std::abs(Pl[5] - Pr[5]) > 1e-3 * Pl[5]) {
     throw CameraInfoError(false, "left and right camera_info P differ in focal length (fx " +
-                          std::to_string(Pl[0]) + " vs " + std::to_string(Pr[0]) +
-                          "): images are not rectified to a common camera");
+                                     std::to_string(Pl[0]) + " vs " + std::to_string(Pr[0]) +
+                                     "): images are not rectified to a common camera");
   }
   if (left.width != right.width || left.height != right.height) {
     throw CameraInfoError(false, "left camera_info is " + std::to_string(left.width) + "x" +
-                          std::to_string(left.height) + " but right camera_info is " +
-                          std::to_string(right.width) + "x" + std::to_string(right.height));
+                                     std::to_string(left.height) + " but right camera_info is " +
+                                     std::to_string(right.width) + "x" +
+                                     std::to_string(right.height));
   }
   StereoCamera camera;
   camera.fx = Pl[0];
@@ -161,12 +162,12 @@ StereoCamera stereoCameraFromInfo(const sensor_msgs::CameraInfo& left,
   if (!(camera.baseline > 0.0) || !std::isfinite(camera.baseline)) {
     throw CameraInfoError(
         false, "right camera_info: P[3] (Tx = -fx * baseline) is " + std::to_string(Pr[3]) +
-        ", equal to the left one: no baseline (is this the right camera's info?)");
+                   ", equal to the left one: no baseline (is this the right camera's info?)");
   }
   const std::string implausible = baselinePlausibilityProblem(camera.baseline);
   if (!implausible.empty()) {
-    throw CameraInfoError(false, "right camera_info: P[3] = " + std::to_string(Pr[3]) +
-                                     " gives a " + implausible);
+    throw CameraInfoError(
+        false, "right camera_info: P[3] = " + std::to_string(Pr[3]) + " gives a " + implausible);
   }
   return camera;
 }

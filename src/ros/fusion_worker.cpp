@@ -4,10 +4,10 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
-#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -17,8 +17,8 @@
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/motion_compensation.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
-#include "lidar_stereo_fusion/ros/ego_motion.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
+#include "lidar_stereo_fusion/ros/ego_motion.h"
 #include "lidar_stereo_fusion/ros/ros_params.h"
 
 namespace lidar_stereo_fusion {
@@ -38,7 +38,7 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
       pnh_(pnh),
       name_(name),
       node_params_(NodeParams::read(pnh)),
-      log_(name),
+      log_(name, node_params_.log_throttle_period),
       gate_(nh, pnh, node_params_, counters_, log_),
       outputs_(nh, pnh, name, node_params_, counters_, gate_),
       tf_listener_(tf_buffer_) {
@@ -77,8 +77,8 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
                       << (node_params_.approximate_sync ? "approximate" : "exact")
                       << " image sync, sweeps matched within " << node_params_.max_time_offset
                       << " s; waiting for a subscriber on the outputs (e.g. "
-                      << topicName("depth/image_rect")
-                      << "), then subscribing to the inputs " << gate_.inputTopics());
+                      << topicName("depth/image_rect") << "), then subscribing to the inputs "
+                      << gate_.inputTopics());
 }
 
 FusionWorker::~FusionWorker() {
@@ -198,7 +198,8 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
                   "; frame skipped");
     return;
   }
-  if (!pair_note.empty() && pair_note != mixed_encodings_said_) {  // said once per pair of encodings
+  if (!pair_note.empty() &&
+      pair_note != mixed_encodings_said_) {  // said once per pair of encodings
     ROS_WARN_STREAM("[" << name_ << "] " << pair_note);
     mixed_encodings_said_ = pair_note;
   }
@@ -207,9 +208,9 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
     log_.warn(kCloud, "nan",
               topicName(kCloud) + ": none of the " + std::to_string(cloud.total_points) +
                   " points of the sweep at " + stampText(match.sweep_stamp) +
-                  " is finite and within 10 km (" +
-                  std::to_string(cloud.non_finite) + " NaN / inf, " +
-                  std::to_string(cloud.implausible) + " beyond 10 km); frame skipped");
+                  " is finite and within 10 km (" + std::to_string(cloud.non_finite) +
+                  " NaN / inf, " + std::to_string(cloud.implausible) +
+                  " beyond 10 km); frame skipped");
     return;
   }
   FrameReport report;
@@ -279,7 +280,7 @@ bool FusionWorker::compensateEgoMotion(const InputMatch& match, const FusionInpu
                                     std::to_string(node_params_.tf_timeout) + " s: " + why);
     }
     compensateMotion(cloud.cloud, sweepMotionFromTf(tf_buffer_, lidar_frame, fixed_frame,
-                                                     match.sweep_stamp, match.image_stamp, times));
+                                                    match.sweep_stamp, match.image_stamp, times));
     // Measured from elsewhere than the camera: what it cannot see beside near objects goes.
     removePointsHiddenBeside(cloud.cloud, input.T_cam_lidar, input.camera);
     report.motion_compensated = true;

@@ -210,9 +210,8 @@ std::string InputGate::inputTopics() const {
 }
 
 bool InputGate::sweepRefusedNear(const ros::Time& image_stamp) const {
-  return !refused_sweep_stamp_.isZero() &&
-         std::abs((refused_sweep_stamp_ - image_stamp).toSec()) <=
-             params_.max_time_offset + params_.max_sweep_wait;
+  return !refused_sweep_stamp_.isZero() && std::abs((refused_sweep_stamp_ - image_stamp).toSec()) <=
+                                               params_.max_time_offset + params_.max_sweep_wait;
 }
 
 std::string InputGate::noSweepText(const ros::Time& image_stamp, bool waited) const {
@@ -231,8 +230,9 @@ std::string InputGate::noSweepText(const ros::Time& image_stamp, bool waited) co
            " s; image set skipped (is the LiDAR publishing? raise ~max_sweep_wait if its sweeps "
            "arrive late)";
   }
-  return "no sweep on " + topicName(kCloud) + " within ~max_time_offset = " +
-         std::to_string(params_.max_time_offset) + " s of the image set at " + at +
+  return "no sweep on " + topicName(kCloud) +
+         " within ~max_time_offset = " + std::to_string(params_.max_time_offset) +
+         " s of the image set at " + at +
          "; image set skipped (raise ~max_time_offset if the clocks differ)";
 }
 

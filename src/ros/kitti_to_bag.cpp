@@ -110,10 +110,10 @@ const char* usage() {
 }
 
 Options parseOptions(int argc, char** argv) {
-  const lsf::CommandLine cl(argc, argv,
-                            {"--kitti-raw", "--out", "--calib-dir", "--frames", "--compression",
-                             "--period", "--cycles"},
-                            {"-h", "--help"});
+  const lsf::CommandLine cl(
+      argc, argv,
+      {"--kitti-raw", "--out", "--calib-dir", "--frames", "--compression", "--period", "--cycles"},
+      {"-h", "--help"});
   if (cl.has("-h") || cl.has("--help")) {
     std::cout << usage();
     std::exit(0);

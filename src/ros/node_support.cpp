@@ -51,6 +51,9 @@ NodeParams NodeParams::read(const ros::NodeHandle& pnh) {
       "must be in [0, 1] s (0 = off)");
   readChecked(pnh, "input_timeout", p.input_timeout, non_negative, "must be >= 0 [s] (0 = off)");
   readChecked(
+      pnh, "log_throttle_period", p.log_throttle_period,
+      [](double v) { return v >= 0.0 && v <= 3600.0; }, "must be in [0, 3600] s (0 = every line)");
+  readChecked(
       pnh, "worker_nice", p.worker_nice, [](int v) { return v >= 0 && v <= 19; },
       "must be in [0, 19]");
   readChecked(pnh, "fixed_frame", p.fixed_frame, any, "");

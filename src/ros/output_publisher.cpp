@@ -217,8 +217,8 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
     confidence_msg = conversions::floatImageToMsg(confidence, header);
   }
   if (pub_points_.getNumSubscribers() > 0) {
-    points_msg = conversions::organizedCloudToMsg(depth, left_image, camera,
-                                                  params_.cloud_stride, header);
+    points_msg =
+        conversions::organizedCloudToMsg(depth, left_image, camera, params_.cloud_stride, header);
   }
   const double total_conversion_ms = report.conversion_ms + msSince(out_start);
 

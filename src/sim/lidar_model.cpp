@@ -47,9 +47,8 @@ void castRing(const Scene& scene, const LidarModel& model, const SweepClock& clo
   for (int j = 0; j < firings; ++j) {
     const double azimuth_deg = (j + 0.5) * model.azimuth_step_deg;  // never exactly 0
     const double azimuth = azimuth_deg * kDegToRad;
-    const double time = clock.moving
-                            ? movingTime(azimuth_deg, clock.front_time, model.sweep_period)
-                            : (j + 0.5) / firings * model.sweep_period;
+    const double time = clock.moving ? movingTime(azimuth_deg, clock.front_time, model.sweep_period)
+                                     : (j + 0.5) / firings * model.sweep_period;
     const Eigen::Isometry3d T_world_lidar = clock.moving ? (*clock.pose_at)(time) : clock.pose;
     const Eigen::Vector3d origin = T_world_lidar.translation();
     const Eigen::Vector3d dir_lidar(std::cos(elevation) * std::cos(azimuth),

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <stdexcept>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -238,9 +238,8 @@ void compareShape(const CostCase& cc, uint32_t seed, lsf::SimdPath wide, int rad
       const double ref = referenceCost(p, *self, other, px, py, plane);
       const auto where = ::testing::Message()
                          << (wide == lsf::SimdPath::kAvx512 ? "avx512" : "avx2") << " seed " << seed
-                         << (round ? " round" : " square")
-                         << " pixel " << px << "," << py << " plane " << a << " " << b << " "
-                         << plane.c;
+                         << (round ? " round" : " square") << " pixel " << px << "," << py
+                         << " plane " << a << " " << b << " " << plane.c;
       // The wide kernels repeat the baseline's float operations in its order: bit-identical.
       ASSERT_EQ(cf, cb) << where;
       ASSERT_NEAR(cb, ref, 1e-4 * std::max(1e-3, ref)) << where;
@@ -415,8 +414,7 @@ TEST(CostSimd, WeightedMedianKernelsAgree) {
       const auto where = ::testing::Message() << "n " << n << " window " << rep;
       ASSERT_EQ(pm::weightedMedianAvx2(d.data(), w.data(), n, padded, half), expected) << where;
       if (lsf::cpuHasAvx512()) {
-        ASSERT_EQ(pm::weightedMedianAvx512(d.data(), w.data(), n, padded, half), expected)
-            << where;
+        ASSERT_EQ(pm::weightedMedianAvx512(d.data(), w.data(), n, padded, half), expected) << where;
       }
     }
   }

@@ -107,7 +107,7 @@ TEST(MovingRig, PointsHiddenBesideANearSurfaceAreRemoved) {
   camera.width = 101;
   camera.height = 41;
   Eigen::Isometry3d T_cam_lidar = Eigen::Isometry3d::Identity();
-  T_cam_lidar.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;  // LiDAR x forward, y left, z up
+  T_cam_lidar.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;          // LiDAR x forward, y left, z up
   T_cam_lidar.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);  // 1 m behind the camera
   LidarCloud cloud;
   const auto add = [&](double x, double y, int ring) {

@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 #include <random>
+#include <vector>
 
 #include "lidar_stereo_fusion/core/patchmatch.h"
 #include "test_scenes.h"
@@ -67,8 +67,8 @@ TEST(PatchMatch, SmoothingKeepsHalfPixelDisparitiesFromLockingToWholePixels) {
       smoothed.compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}}).disparity, s, 8);
   p.image_smoothing = 0.0;
   lsf::PatchMatchStereo raw(p);
-  const double without = meanError(
-      raw.compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}}).disparity, s, 8);
+  const double without =
+      meanError(raw.compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}}).disparity, s, 8);
   EXPECT_LT(with, 0.05);
   EXPECT_LT(with, 0.5 * without);
 }
@@ -174,11 +174,11 @@ TEST(PatchMatch, DeterministicForSeedAndThreadCount) {
       p.intermediate_refine = false;
     }
     p.num_threads = 1;
-    const auto a = lsf::PatchMatchStereo(p).compute({s.left, cv::Mat1f(), {}},
-                                                    {s.right, cv::Mat1f(), {}});
+    const auto a =
+        lsf::PatchMatchStereo(p).compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}});
     p.num_threads = 2;
-    const auto b = lsf::PatchMatchStereo(p).compute({s.left, cv::Mat1f(), {}},
-                                                    {s.right, cv::Mat1f(), {}});
+    const auto b =
+        lsf::PatchMatchStereo(p).compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}});
     EXPECT_EQ(cv::norm(a.disparity, b.disparity, cv::NORM_INF), 0.0) << "live " << live;
   }
 }

@@ -147,8 +147,8 @@ TEST(PatchMatchCoarseStart, AtUnboundedScale2StereoOnlyPixelsAreTheHalfSizePlane
     p.num_threads = 1;
     const lsf::PatchMatchResult full = lsf::PatchMatchStereo(p).compute({s.left}, {s.right});
     lsf::PatchMatchStereo half_level(pm::coarseParams(p));
-    const lsf::PatchMatchResult half = half_level.compute(pm::downsampleView({s.left}, 2),
-                                                          pm::downsampleView({s.right}, 2));
+    const lsf::PatchMatchResult half =
+        half_level.compute(pm::downsampleView({s.left}, 2), pm::downsampleView({s.right}, 2));
     // A stand-alone solver is not an intermediate level, so it refines its right view whatever
     // intermediate_refine says: the planes are compared only where that is the same (true).
     const std::vector<pm::Plane> up = pm::upsamplePlanes(half.planes, 2, s.left.size());
@@ -192,9 +192,9 @@ TEST(PatchMatchCoarseStart, AtSearchScale2FullSizeUpsamplesTheCheckedAndFilledHa
   EXPECT_TRUE(half_params.lr_check);  // the level that fills
   EXPECT_EQ(half_params.lr_max_diff, p.lr_max_diff / 2);
   EXPECT_EQ(half_params.search_scale, 1);
-  const lsf::PatchMatchResult half = lsf::PatchMatchStereo(half_params)
-                                         .compute(pm::downsampleView(left, 2),
-                                                  pm::downsampleView(right, 2));
+  const lsf::PatchMatchResult half =
+      lsf::PatchMatchStereo(half_params)
+          .compute(pm::downsampleView(left, 2), pm::downsampleView(right, 2));
   const std::vector<pm::Plane> up = pm::upsamplePlanes(half.planes, 2, s.left.size());
   int checked = 0, filled = 0;
   for (int y = 0; y < 48; ++y) {
@@ -389,8 +389,8 @@ TEST(PatchMatchCoarseStart, SkippingInconsistentPixelsKeepsForegroundEdges) {
     for (int y = 8; y < 56; ++y) {
       for (int x = 24; x < 104; ++x) {
         if (x >= 32 && x < 40) continue;  // hidden in the right view
-        const double truth = x >= BoxScene::kBox0 && x < BoxScene::kBox1 ? BoxScene::kBox
-                                                                          : BoxScene::kBack;
+        const double truth =
+            x >= BoxScene::kBox0 && x < BoxScene::kBox1 ? BoxScene::kBox : BoxScene::kBack;
         error += std::abs(r.disparity(y, x) - truth);
         ++seen;
       }

@@ -98,7 +98,8 @@ TEST(PcdPcl, CorruptBinaryCompressedIsRefusedWithThisPackagesMessages) {
     std::string name, bytes, message;
   };
   std::string flipped = bytes;
-  for (std::size_t k = at + 8; k < flipped.size(); k += 97) flipped[k] = static_cast<char>(~flipped[k]);
+  for (std::size_t k = at + 8; k < flipped.size(); k += 97)
+    flipped[k] = static_cast<char>(~flipped[k]);
   const Case cases[] = {
       {"no_sizes", bytes.substr(0, at + 3), "no compressed and uncompressed sizes"},
       {"cut", bytes.substr(0, at + 8 + sizes[0] / 2), "compressed bytes announced"},
@@ -146,7 +147,12 @@ TEST(PcdPcl, HeadersThatCrashedPclAreRefusedFirst) {
   const struct {
     std::string name, bytes, message;
   } cases[] = {
-      {"nul", std::string("VERSIO\xc8\t\0\0" "7\n", 11) + fields + rest, "holds byte 200"},
+      {"nul",
+       std::string("VERSIO\xc8\t\0\0"
+                   "7\n",
+                   11) +
+           fields + rest,
+       "holds byte 200"},
       {"unknown_key", "VIEWPOI 0.7\n" + fields + rest, "unknown line 'VIEWPOI ...'"},
       {"no_points", fields + "WIDTH 1\nHEIGHT 1\nPODATA 1\nDATA binary\n123456789012",
        "unknown line 'PODATA ...'"},
@@ -166,8 +172,9 @@ TEST(PcdPcl, UnknownDataKindIsNamed) {
   writeBytes(tempPath("zip.pcd"),
              "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nPOINTS 1\nDATA zip\n");
   // and a header of known lines in an order PCL refuses (COUNT before TYPE) is PCL's refusal
-  writeBytes(tempPath("order.pcd"), "FIELDS x y z\nSIZE 4 4 4\nCOUNT 1 1 1\nTYPE F F F\nWIDTH 1\n"
-                                    "POINTS 1\nDATA ascii\n1 2 3\n");
+  writeBytes(tempPath("order.pcd"),
+             "FIELDS x y z\nSIZE 4 4 4\nCOUNT 1 1 1\nTYPE F F F\nWIDTH 1\n"
+             "POINTS 1\nDATA ascii\n1 2 3\n");
   EXPECT_NE(readError(tempPath("order.pcd")).find("PCL's reader refused"), std::string::npos);
   EXPECT_NE(readError(tempPath("zip.pcd")).find("unknown DATA 'zip'"), std::string::npos);
 }

@@ -43,7 +43,8 @@ std::string readAll(const fs::path& path) {
 }
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("lsf_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("lsf_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -158,8 +159,7 @@ TEST(PcdData, KittiRunnerSavePcdHoldsExactlyTheFinitePointsOfEachFramesDepth) {
 
     const kitti::FrameData data = kitti::loadFrame(frame, calib.camera);
     const cv::Mat1f depth =
-        pipeline.process({data.left, data.right, data.cloud, calib.T_cam_velo, calib.camera})
-            .depth;
+        pipeline.process({data.left, data.right, data.cloud, calib.T_cam_velo, calib.camera}).depth;
     std::size_t next = 0, far = 0, with_depth = 0;
     for (int v = 0; v < depth.rows; ++v) {
       for (int u = 0; u < depth.cols; ++u) {

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -26,9 +25,6 @@ const char* const kVls128 = "vls128/1585897255376374245.pcd";
 double elevationDeg(const LidarPoint& p) {
   return std::atan2(p.z, std::hypot(p.x, p.y)) * 180.0 / M_PI;
 }
-
-/// Process CPU time [ms]: the work done on all cores, insensitive to other processes' load.
-double cpuMilliseconds() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 
 TEST(KittiRings, EverySweepHasExactly64RingsTopToBottom) {
   LSF_REQUIRE_DATA(kDrive);
@@ -181,36 +177,6 @@ TEST_F(KittiFrame0, BIStarCoversTheBandBetweenTopAndBottomLinesAndRemovesLeaks) 
   std::printf("[ KITTI 0 ] BF*: coverage between lines %.2f %%, dense pixels %d\n",
               100.0 * coverageBetweenLines(lines.disparity, bf), cv::countNonZero(bf));
   EXPECT_GT(coverageBetweenLines(lines.disparity, bf), 0.5);
-}
-
-TEST_F(KittiFrame0, TimingOfProjectionAndUpsampling) {
-  // Reported, not asserted. CPU time of the whole process (all threads): the cost on one core,
-  // whatever else the machine runs. Target: projection + BI* < 30 ms, BF* well under 100 ms.
-  const StereoCamera& camera = calibration_.camera;
-  const int repetitions = 10;
-  double rings_ms = 0, projection_ms = 0, bi_ms = 0, bf_ms = 0;
-  for (int i = 0; i < repetitions; ++i) {
-    LidarCloud cloud = data_.cloud;
-    double start = cpuMilliseconds();
-    recoverRingsBySweepOrder(cloud);
-    rings_ms += cpuMilliseconds() - start;
-    start = cpuMilliseconds();
-    const SparseDisparity s =
-        projectCloud(cloud, calibration_.T_cam_velo, camera, ProjectionParams());
-    projection_ms += cpuMilliseconds() - start;
-    start = cpuMilliseconds();
-    const cv::Mat1f bi = upsampleBI(s, data_.left, BIParams());
-    bi_ms += cpuMilliseconds() - start;
-    start = cpuMilliseconds();
-    const cv::Mat1f bf = upsampleBF(s, BFParams());
-    bf_ms += cpuMilliseconds() - start;
-  }
-  std::printf(
-      "[ KITTI 0 ] CPU time, mean of %d: ring recovery %.2f ms, projection %.2f ms, "
-      "BI* %.2f ms (projection + BI* %.2f ms), BF* %.2f ms\n",
-      repetitions, rings_ms / repetitions, projection_ms / repetitions, bi_ms / repetitions,
-      (projection_ms + bi_ms) / repetitions, bf_ms / repetitions);
-  SUCCEED();
 }
 
 }  // namespace

@@ -29,13 +29,11 @@ using lsf::test::kRightCameraFrame;
 
 constexpr int kWidth = 320, kHeight = 120;
 constexpr double kOutputTimeout = 20.0;  ///< [s] first frame includes pipeline warm-up
-constexpr double kNoOutputWait = 1.5;    ///< [s] > max_sweep_wait + processing of a small frame
 
 /// The output topics, relative to the fusion namespace.
 const std::vector<std::string> kOutputs = {
-    "disparity",         "depth/image_rect", "depth/camera_info",
-    "depth/image_color", "points2",          "lidar_disparity",
-    "disparity_image",   "disparity_image_color", "confidence", "stats"};
+    "disparity",       "depth/image_rect", "depth/camera_info",     "depth/image_color", "points2",
+    "lidar_disparity", "disparity_image",  "disparity_image_color", "confidence",        "stats"};
 
 /// How one input set is made.
 struct SetSpec {
@@ -102,6 +100,14 @@ class Harness {
     const ros::Time now = ros::Time::now();
     last_stamp_ = std::max(now, last_stamp_ + ros::Duration(0.2));
     return last_stamp_;
+  }
+
+  /// nextStamp() once the clock has reached it (sets sent in a burst run ahead of it), for a test
+  /// that checks the latency (publish time - stamp) of its sets. Waits at most 10 s.
+  ros::Time nextStampNotAhead() {
+    const ros::Time stamp = nextStamp();
+    waitFor(10.0, [&] { return ros::Time::now() >= stamp; });
+    return stamp;
   }
 
   sensor_msgs::PointCloud2Ptr makeCloud(const SetSpec& spec, const ros::Time& stamp) const {
@@ -226,12 +232,22 @@ class Harness {
       return true;
     });
   }
-  /// Number of outputs that got anything stamped `stamp` within `wait`.
-  int outputsAfter(const ros::Time& stamp, double wait = kNoOutputWait) {
-    ros::WallDuration(wait).sleep();
+  /// Number of outputs that got anything stamped `stamp` so far.
+  int outputsSoFar(const ros::Time& stamp) {
     int n = 0;
     for (const auto& name : kOutputs) n += count(name, stamp);
     return n;
+  }
+  /// Forgets the latest output messages (not the counts per stamp), so that a test reads only
+  /// what came out for its own sets.
+  void forgetLatestOutputs() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    frame_ids_.clear();
+    disparity_.reset();
+    images_.clear();
+    depth_info_.reset();
+    points_.reset();
+    stats_.reset();
   }
   std::string frameId(const std::string& name) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -291,6 +307,33 @@ class Harness {
     return out;
   }
 
+  /// [s] the node's ~log_throttle_period (the .test files set it short; default 5 s).
+  double throttlePeriod() const {
+    double period = 5.0;
+    ros::param::get(fusion_node_ + "/log_throttle_period", period);
+    return period;
+  }
+  /// Waits until a throttle period has passed since the last WARN or ERROR of the process under
+  /// test arrived, so that every (topic, kind) may be logged again.
+  bool waitForThrottleExpiry(double timeout) {
+    const auto period = std::chrono::duration<double>(throttlePeriod());
+    return waitFor(timeout, [&] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      return std::chrono::steady_clock::now() - last_warning_ >= period;
+    });
+  }
+  /// The nodelet is up: its outputs are advertised.
+  bool nodeUp(double timeout) {
+    return waitFor(timeout, [&] {
+      ros::master::V_TopicInfo topics;
+      ros::master::getTopics(topics);
+      for (const auto& t : topics) {
+        if (t.name == output("stats")) return true;
+      }
+      return false;
+    });
+  }
+
   /// The process hosting the nodelet is registered with the master.
   bool processAlive() {
     std::vector<std::string> nodes;
@@ -318,6 +361,9 @@ class Harness {
   void logCb(const rosgraph_msgs::LogConstPtr& msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     logs_.push_back(*msg);
+    if (msg->level >= rosgraph_msgs::Log::WARN && msg->name == process_node_) {
+      last_warning_ = std::chrono::steady_clock::now();
+    }
   }
 
   ros::NodeHandle nh_, pnh_;
@@ -339,6 +385,7 @@ class Harness {
   sensor_msgs::PointCloud2ConstPtr points_;
   lsf::FusionStatsConstPtr stats_;
   std::vector<rosgraph_msgs::Log> logs_;
+  std::chrono::steady_clock::time_point last_warning_;  ///< arrival of the last one
 };
 
 }  // namespace fusion_test

@@ -24,10 +24,10 @@
 namespace {
 
 struct Sample {
-  double receipt;     ///< [s] wall
-  double latency_ms;  ///< stamp -> publish, from FusionStats
-  double receipt_ms;  ///< stamp -> receipt here
-  double total_ms;    ///< core pipeline
+  double receipt;        ///< [s] wall
+  double latency_ms;     ///< stamp -> publish, from FusionStats
+  double receipt_ms;     ///< stamp -> receipt here
+  double total_ms;       ///< core pipeline
   double conversion_ms;  ///< ROS conversions in and out (not in total_ms)
   uint32_t dropped, unmatched, processed;
 };
@@ -121,9 +121,8 @@ int main(int argc, char** argv) {
       "  meanwhile: %u sets dropped (newer one waiting), %u unmatched; %d frames across a time "
       "jump "
       "not counted\n",
-      samples.size(), span, (samples.size() - 1) / span,
-      mean(latency), percentile(latency, 0.5), percentile(latency, 0.95),
-      percentile(latency, 1.0), mean(receipt), percentile(receipt, 0.5),
+      samples.size(), span, (samples.size() - 1) / span, mean(latency), percentile(latency, 0.5),
+      percentile(latency, 0.95), percentile(latency, 1.0), mean(receipt), percentile(receipt, 0.5),
       percentile(receipt, 0.95), mean(total), percentile(total, 0.5), percentile(total, 0.95),
       percentile(total, 1.0), mean(conversion), percentile(conversion, 0.95), mean(waited),
       percentile(waited, 0.95), samples.back().dropped - samples.front().dropped,

@@ -330,15 +330,15 @@ TEST(KittiToBag, WritesTheRigTopicsForEveryCompleteFrame) {
 TEST(KittiToBag, BadInputFailsWithoutWritingABag) {
   const std::string bag_path = scratchDir() + "/bad.bag";
   fs::remove(bag_path);
-  auto [status, output] = runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + scratchDir() +
-                              "/no_such_drive --out " + bag_path);
+  auto [status, output] = runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " +
+                                     scratchDir() + "/no_such_drive --out " + bag_path);
   EXPECT_EQ(status, 1) << output;
   EXPECT_NE(output.find("no_such_drive"), std::string::npos) << output;
   std::tie(status, output) = runCommand(std::string(LSF_KITTI_TO_BAG) + " --out " + bag_path);
   EXPECT_EQ(status, 2) << output;
   EXPECT_NE(output.find("--kitti-raw"), std::string::npos) << output;
-  std::tie(status, output) =
-      runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw x --out " + bag_path + " --frames -3");
+  std::tie(status, output) = runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw x --out " +
+                                        bag_path + " --frames -3");
   EXPECT_EQ(status, 2) << output;
   EXPECT_FALSE(fs::exists(bag_path));
   EXPECT_FALSE(fs::exists(bag_path + ".partial"));
@@ -413,7 +413,7 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
   // Same parameter file as the nodelet's (fusion.launch loads config/fusion.yaml).
   const auto [runner_status, runner_output] =
       runCommand(std::string(LSF_KITTI_RUNNER) + " --kitti-raw " + drive + " --out " + runner_out +
-          " --params " + LSF_SOURCE_DIR + "/config/fusion.yaml");
+                 " --params " + LSF_SOURCE_DIR + "/config/fusion.yaml");
   ASSERT_EQ(runner_status, 0) << runner_output;
 
   std::lock_guard<std::mutex> lock(outputs.mutex_);

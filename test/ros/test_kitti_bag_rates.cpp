@@ -186,8 +186,9 @@ TEST(KittiBagRates, EveryPublishedDepthIsItsOwnFramesAtAnyPlaybackRate) {
       EXPECT_GE(lo, 0.0);
       EXPECT_LE(hi, 1.0);
     }
-    std::printf("rosbag play -r %.1f: %d of %zu frames published, each equal to the offline depth\n",
-                rate, published, stamps.size());
+    std::printf(
+        "rosbag play -r %.1f: %d of %zu frames published, each equal to the offline depth\n", rate,
+        published, stamps.size());
     EXPECT_GT(published, 0);
   }
 }

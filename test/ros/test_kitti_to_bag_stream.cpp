@@ -32,9 +32,9 @@ TEST(KittiToBagStream, RestampsTheFramesAtThePeriodAndRepeatsThem) {
   const std::string drive = lt::makeSubsetDrive(scratchDir(), names);
   const std::string bag_path = scratchDir() + "/stream.bag";
   fs::remove(bag_path);
-  const auto [status, output] = lt::runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " +
-                                               drive + " --out " + bag_path +
-                                               " --period 0.1 --cycles 3");
+  const auto [status, output] =
+      lt::runCommand(std::string(LSF_KITTI_TO_BAG) + " --kitti-raw " + drive + " --out " +
+                     bag_path + " --period 0.1 --cycles 3");
   ASSERT_EQ(status, 0) << output;
   EXPECT_NE(output.find("wrote 6 frame(s)"), std::string::npos) << output;
   // KITTI's sweeps end ~40 ms after their images: less than half the period, no warning.

@@ -57,10 +57,11 @@ TEST(LaunchFiles, PresetLiveLoadsConfigLiveEverywhere) {
         {"measure_live.launch", "preset:=live"},
         {"zed_vls128.launch", ""}}) {
     const std::string dump = dumpParams(launch, args);
-    EXPECT_NE(dump.find("/fusion/fusion/search_scale: 2"), std::string::npos)
-        << launch << "\n" << dump;
+    EXPECT_NE(dump.find("/fusion/fusion/search_scale: 2"), std::string::npos) << launch << "\n"
+                                                                              << dump;
     EXPECT_NE(dump.find("/fusion/fusion/intermediate_refine: false"), std::string::npos)
-        << launch << "\n" << dump;
+        << launch << "\n"
+        << dump;
   }
   const std::string fusion = dumpParams("fusion.launch");
   EXPECT_NE(fusion.find("/fusion/fusion/search_scale: 1"), std::string::npos) << fusion;
@@ -74,10 +75,9 @@ TEST(LaunchFiles, PclFiltersAreOffByDefaultAndPassedThroughFromRigAndPlayback) {
   EXPECT_EQ(plain.find("/fusion/self_filter/"), std::string::npos) << plain;
   EXPECT_EQ(plain.find("/fusion/points2_voxel_grid/"), std::string::npos) << plain;
   const std::string box = "self_filter_min:='-3 -1.5 -2.5' self_filter_max:='1.5 1.5 0.5' ";
-  for (const auto& [launch, args] :
-       {std::pair<std::string, std::string>{"fusion.launch", ""},
-        {"playback.launch", "bag:=/nonexistent.bag "},
-        {"zed_vls128.launch", ""}}) {
+  for (const auto& [launch, args] : {std::pair<std::string, std::string>{"fusion.launch", ""},
+                                     {"playback.launch", "bag:=/nonexistent.bag "},
+                                     {"zed_vls128.launch", ""}}) {
     const std::string dump = dumpParams(launch, args + box + "voxel_leaf_size:=0.25");
     for (const char* expected :
          {"/fusion/self_filter/negative: true", "/fusion/self_filter/min_x: -3.0",

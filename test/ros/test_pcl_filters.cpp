@@ -60,9 +60,9 @@ struct Inbox {
 class Collector {
  public:
   explicit Collector(ros::NodeHandle& nh) {
-    subs_ = {sub(nh, "velodyne_points_self_filtered", filtered_),
-             sub(nh, "points2", points_), sub(nh, "points2_voxel", voxel_),
-             sub(nh, "lidar_disparity", prior_), sub(nh, "stats", stats_)};
+    subs_ = {sub(nh, "velodyne_points_self_filtered", filtered_), sub(nh, "points2", points_),
+             sub(nh, "points2_voxel", voxel_), sub(nh, "lidar_disparity", prior_),
+             sub(nh, "stats", stats_)};
   }
   bool connected() const {
     for (const auto& s : subs_) {
@@ -222,13 +222,16 @@ TEST(PclFilters, CropBoxAndVoxelGridInTheFusionsManager) {
   while (!connected() && ros::WallTime::now() < give_up) ros::WallDuration(0.1).sleep();
   ASSERT_TRUE(connected()) << "the fusion and the pcl_ros filters did not connect";
 
-  std::printf("frame       | CropBox in test [ms] | VoxelGrid in test [ms] | fusion total_ms | "
-              "sweep -> filtered [ms] | points2 -> voxel [ms] | points2 / voxel points\n");
+  std::printf(
+      "frame       | CropBox in test [ms] | VoxelGrid in test [ms] | fusion total_ms | "
+      "sweep -> filtered [ms] | points2 -> voxel [ms] | points2 / voxel points\n");
   for (size_t i = 0; i < kFrames.size(); ++i) {
     SCOPED_TRACE("frame " + kFrames[i]);
     const auto sweep = topics["/velodyne_points"][i].instantiate<Cloud>();
-    const auto left_info = topics["/stereo/left/camera_info"][i].instantiate<sensor_msgs::CameraInfo>();
-    const auto right_info = topics["/stereo/right/camera_info"][i].instantiate<sensor_msgs::CameraInfo>();
+    const auto left_info =
+        topics["/stereo/left/camera_info"][i].instantiate<sensor_msgs::CameraInfo>();
+    const auto right_info =
+        topics["/stereo/right/camera_info"][i].instantiate<sensor_msgs::CameraInfo>();
     const auto left = topics["/stereo/left/image_rect_color"][i].instantiate<sensor_msgs::Image>();
     const Expected expected = expectedOf(*sweep, T_cam_velo, *left_info, *right_info);
     ASSERT_GT(expected.max_disparity_inside, expected.max_disparity_outside + 1.0)
@@ -256,7 +259,8 @@ TEST(PclFilters, CropBoxAndVoxelGridInTheFusionsManager) {
     const auto& filtered = *got.at(got.filtered_, sweep->header.stamp);
     EXPECT_EQ(static_cast<int>(filtered.first->width * filtered.first->height), expected.outside);
     const auto& stats = *got.at(got.stats_, t)->first;
-    EXPECT_EQ(stats.points_in_cloud, expected.outside) << "the fusion's input is the filtered sweep";
+    EXPECT_EQ(stats.points_in_cloud, expected.outside)
+        << "the fusion's input is the filtered sweep";
     double lo = 0, hi = 0;
     cv::minMaxLoc(cv_bridge::toCvShare(got.at(got.prior_, t)->first)->image, &lo, &hi);
     EXPECT_GT(hi, 0.0);
@@ -270,10 +274,10 @@ TEST(PclFilters, CropBoxAndVoxelGridInTheFusionsManager) {
     EXPECT_GT(voxel_n, 0);
     EXPECT_LT(voxel_n, points_n);
     EXPECT_EQ(voxel.first->header.frame_id, points.first->header.frame_id);
-    std::printf("%s  | %20.1f | %22.1f | %15.1f | %22.1f | %21.1f | %d / %d\n",
-                kFrames[i].c_str(), cropBoxMs(*sweep), voxelGridMs(*points.first),
-                stats.total_ms, (filtered.second - sent) * 1e3, (voxel.second - points.second) * 1e3,
-                points_n, voxel_n);
+    std::printf("%s  | %20.1f | %22.1f | %15.1f | %22.1f | %21.1f | %d / %d\n", kFrames[i].c_str(),
+                cropBoxMs(*sweep), voxelGridMs(*points.first), stats.total_ms,
+                (filtered.second - sent) * 1e3, (voxel.second - points.second) * 1e3, points_n,
+                voxel_n);
   }
   ros::WallDuration(1.0).sleep();  // a late extra message would arrive now
   std::lock_guard<std::mutex> lock(got.mutex_);

@@ -70,13 +70,14 @@ std::unique_ptr<lt::Child> startPlayback(const std::vector<std::string>& args,
 class FusionWarnings {
  public:
   explicit FusionWarnings(ros::NodeHandle& nh)
-      : sub_(nh.subscribe<rosgraph_msgs::Log>(
-            "/rosout", 500, [this](const rosgraph_msgs::LogConstPtr& m) {
-              if (m->level < rosgraph_msgs::Log::WARN) return;
-              if (m->name.find("fusion") == std::string::npos) return;
-              std::lock_guard<std::mutex> lock(mutex_);
-              lines_.push_back(m->msg);
-            })) {}
+      : sub_(nh.subscribe<rosgraph_msgs::Log>("/rosout", 500,
+                                              [this](const rosgraph_msgs::LogConstPtr& m) {
+                                                if (m->level < rosgraph_msgs::Log::WARN) return;
+                                                if (m->name.find("fusion") == std::string::npos)
+                                                  return;
+                                                std::lock_guard<std::mutex> lock(mutex_);
+                                                lines_.push_back(m->msg);
+                                              })) {}
   /// The warnings containing `part`, one per line.
   std::string containing(const std::string& part) {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -66,10 +66,21 @@ sensor_msgs::PointCloud2 timedCloud(const std::vector<std::pair<std::string, uin
       uint8_t* q = p + msg.fields[3 + k].offset;
       const double v = values[i][k];
       switch (fields[k].second) {
-        case PointField::FLOAT32: { const float f = static_cast<float>(v); std::memcpy(q, &f, 4); break; }
-        case PointField::FLOAT64: std::memcpy(q, &v, 8); break;
-        case PointField::UINT32: { const uint32_t u = static_cast<uint32_t>(v); std::memcpy(q, &u, 4); break; }
-        default: ADD_FAILURE() << "type not used here";
+        case PointField::FLOAT32: {
+          const float f = static_cast<float>(v);
+          std::memcpy(q, &f, 4);
+          break;
+        }
+        case PointField::FLOAT64:
+          std::memcpy(q, &v, 8);
+          break;
+        case PointField::UINT32: {
+          const uint32_t u = static_cast<uint32_t>(v);
+          std::memcpy(q, &u, 4);
+          break;
+        }
+        default:
+          ADD_FAILURE() << "type not used here";
       }
     }
   }
@@ -95,8 +106,8 @@ TEST(PointTime, VelodyneTimeIsSecondsFromTheStamp) {
 
 TEST(PointTime, OusterAndLivoxNanosecondsFromTheStamp) {
   for (const char* name : {"t", "offset_time"}) {
-    const auto c = conv::cloudFromMsg(timedCloud({{name, PointField::UINT32}},
-                                                 {{0.0}, {50000000.0}, {99000000.0}}, kStamp));
+    const auto c = conv::cloudFromMsg(
+        timedCloud({{name, PointField::UINT32}}, {{0.0}, {50000000.0}, {99000000.0}}, kStamp));
     EXPECT_STREQ(conv::pointTimeFieldName(c.time_field), name);
     ASSERT_EQ(c.cloud.size(), 3u);
     EXPECT_FLOAT_EQ(c.cloud[0].time, 0.f);
@@ -107,8 +118,8 @@ TEST(PointTime, OusterAndLivoxNanosecondsFromTheStamp) {
 
 TEST(PointTime, HesaiAbsoluteTimestamp) {
   const double s = kStamp.toSec();
-  const auto c = conv::cloudFromMsg(timedCloud({{"timestamp", PointField::FLOAT64}},
-                                               {{s - 0.1}, {s - 0.05}, {s}}, kStamp));
+  const auto c = conv::cloudFromMsg(
+      timedCloud({{"timestamp", PointField::FLOAT64}}, {{s - 0.1}, {s - 0.05}, {s}}, kStamp));
   EXPECT_EQ(c.time_field, conv::PointTimeField::kTimestamp);
   ASSERT_EQ(c.cloud.size(), 3u);
   EXPECT_NEAR(c.cloud[0].time, -0.1, 1e-6);  // a double at 1.3e9 s keeps ~0.2 us
@@ -117,11 +128,10 @@ TEST(PointTime, HesaiAbsoluteTimestamp) {
 }
 
 TEST(PointTime, LuminarSecondsAndNanosecondsExactly) {
-  const auto msg =
-      timedCloud({{"time_sec", PointField::UINT32}, {"time_nsec", PointField::UINT32}},
-                 {{1317013000.0, 412500000.0}, {1317013000.0, 500000000.0},
-                  {1317012999.0, 937500000.0}},
-                 kStamp);
+  const auto msg = timedCloud(
+      {{"time_sec", PointField::UINT32}, {"time_nsec", PointField::UINT32}},
+      {{1317013000.0, 412500000.0}, {1317013000.0, 500000000.0}, {1317012999.0, 937500000.0}},
+      kStamp);
   const auto c = conv::cloudFromMsg(msg, 1.0);
   EXPECT_EQ(c.time_field, conv::PointTimeField::kTimeSecNsec);
   EXPECT_EQ(times(c), (std::vector<float>{-0.0875f, 0.f, -0.5625f}));
@@ -150,8 +160,9 @@ TEST(PointTime, ImplausibleTimesAreCountedAndNotUsed) {
 
 TEST(PointTime, OneRuleWhenSeveralFieldsArePresent) {
   // `time` wins over `t`; `time_sec` alone is no time.
-  const auto c = conv::cloudFromMsg(timedCloud(
-      {{"t", PointField::UINT32}, {"time", PointField::FLOAT32}}, {{1e6, 0.25}}, kStamp), 1.0);
+  const auto c = conv::cloudFromMsg(
+      timedCloud({{"t", PointField::UINT32}, {"time", PointField::FLOAT32}}, {{1e6, 0.25}}, kStamp),
+      1.0);
   EXPECT_EQ(c.time_field, conv::PointTimeField::kTime);
   EXPECT_FLOAT_EQ(c.cloud[0].time, 0.25f);
   const auto d =
@@ -186,8 +197,8 @@ TEST(PointTime, LuminarBagSweepsEndAtTheirStamp) {
     EXPECT_EQ(c.bad_times, 0);
     float first = 1.f, last = -1.f;
     for (const auto& p : c.cloud) first = std::min(first, p.time), last = std::max(last, p.time);
-    EXPECT_NEAR(last, 0.0, 1e-3) << "sweep " << sweeps;      // ends at its stamp
-    EXPECT_GT(last - first, 0.05) << "sweep " << sweeps;     // a sweep of ~90 ms
+    EXPECT_NEAR(last, 0.0, 1e-3) << "sweep " << sweeps;   // ends at its stamp
+    EXPECT_GT(last - first, 0.05) << "sweep " << sweeps;  // a sweep of ~90 ms
     EXPECT_LT(last - first, 0.12) << "sweep " << sweeps;
     ++sweeps;
   }

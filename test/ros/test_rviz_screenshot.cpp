@@ -258,8 +258,8 @@ TEST(RvizScreenshot, FusedCloudIsDrawn) {
             << 100 * left_dock_colour << " %\n";
   EXPECT_GT(depth_colour, 0.10) << "no coloured depth in the middle of the right dock (" << shot_b
                                 << ")";
-  EXPECT_GT(disparity_colour, 0.10) << "no coloured disparity at the bottom of the right dock ("
-                                    << shot_b << ")";
+  EXPECT_GT(disparity_colour, 0.10)
+      << "no coloured disparity at the bottom of the right dock (" << shot_b << ")";
   EXPECT_LT(left_dock_colour, 0.01) << "a picture in the left dock (" << shot_b << ")";
   rviz.stop();
   xvfb.stop();

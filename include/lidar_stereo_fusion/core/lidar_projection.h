@@ -22,10 +22,10 @@ enum class View { kLeft, kRight };
 
 /// Sparse LiDAR disparity in one view.
 struct SparseDisparity {
-  cv::Mat1f disparity;      ///< [px], 0 = no point (z-buffer: nearest point kept per pixel)
-  cv::Mat1s ring;           ///< ring index of the kept point, -1 where empty or unknown
-  int points_in_front = 0;  ///< points with min_depth <= z <= max_depth
-  int points_in_image = 0;  ///< of those, points that landed inside the image
+  cv::Mat1f disparity;        ///< [px], 0 = no point (z-buffer: nearest point kept per pixel)
+  cv::Mat1s ring;             ///< ring index of the kept point, -1 where empty or unknown
+  int points_in_front = 0;    ///< points with min_depth <= z <= max_depth
+  int points_in_image = 0;    ///< of those, points that landed inside the image
   int points_not_finite = 0;  ///< points skipped because x, y or z is NaN / inf
 };
 

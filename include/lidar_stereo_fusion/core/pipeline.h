@@ -15,11 +15,11 @@
 namespace lidar_stereo_fusion {
 
 enum class Method {
-  kFusedBI,     ///< the paper: BI* prior + guided PatchMatch (default)
-  kFusedBF,     ///< BF* prior + guided PatchMatch
-  kPlainPMS,    ///< PatchMatch stereo without LiDAR (gamma = 0, no bounds, random init)
-  kLidarBI,     ///< BI* up-sampled LiDAR only
-  kLidarBF,     ///< BF* up-sampled LiDAR only
+  kFusedBI,   ///< the paper: BI* prior + guided PatchMatch (default)
+  kFusedBF,   ///< BF* prior + guided PatchMatch
+  kPlainPMS,  ///< PatchMatch stereo without LiDAR (gamma = 0, no bounds, random init)
+  kLidarBI,   ///< BI* up-sampled LiDAR only
+  kLidarBF,   ///< BF* up-sampled LiDAR only
 };
 
 /// "fused_bi", "fused_bf", "pms", "lidar_bi", "lidar_bf".
@@ -42,15 +42,15 @@ struct FusionParams {
 /// Per-stage wall time [ms] and counts of one frame.
 struct FrameStats {
   double projection_ms = 0, upsampling_ms = 0, patchmatch_ms = 0, depth_ms = 0, total_ms = 0;
-  int points_in_front = 0;      ///< points in the depth range in front of the camera
-  int points_projected = 0;     ///< points landing in the left image
-  int points_removed = 0;       ///< scan-line pixels removed by Algorithm 1 (left view)
-  double prior_coverage = 0;    ///< fraction of pixels with an up-sampled prior
-  double output_coverage = 0;   ///< fraction of pixels with an output disparity
+  int points_in_front = 0;     ///< points in the depth range in front of the camera
+  int points_projected = 0;    ///< points landing in the left image
+  int points_removed = 0;      ///< scan-line pixels removed by Algorithm 1 (left view)
+  double prior_coverage = 0;   ///< fraction of pixels with an up-sampled prior
+  double output_coverage = 0;  ///< fraction of pixels with an output disparity
 };
 
 struct FusionResult {
-  SparseDisparity sparse;   ///< stage 1 (left view)
+  SparseDisparity sparse;  ///< stage 1 (left view)
   /// Stage 2 (left view) [px], 0 = empty. For the fused methods with confidence weighting, the
   /// prior PatchMatch used: BI* (or BF*) plus the hole fill (fillPriorHoles) at low confidence.
   cv::Mat1f prior;
@@ -58,8 +58,8 @@ struct FusionResult {
   /// lower between scan lines that disagree and where Algorithm 1 removed points, 0 where the
   /// prior is empty. Empty for methods without LiDAR. See PriorConfidenceParams.
   cv::Mat1f confidence;
-  cv::Mat1f disparity;      ///< final disparity [px], 0 = no value
-  cv::Mat1f depth;          ///< final depth [m], 0 = no value
+  cv::Mat1f disparity;  ///< final disparity [px], 0 = no value
+  cv::Mat1f depth;      ///< final depth [m], 0 = no value
   FrameStats stats;
 };
 

@@ -101,17 +101,18 @@ struct CloudConversion {
   /// time 0 (the stamp's), and the caller names them; bad_time_example is the first such value.
   int bad_times = 0;
   double bad_time_example = 0.0;
-  int total_points = 0;   ///< width * height of the message
-  int non_finite = 0;     ///< points skipped because x, y or z was NaN / inf
-  int implausible = 0;    ///< points skipped because |x|, |y| or |z| > kMaxCoordinate
+  int total_points = 0;  ///< width * height of the message
+  int non_finite = 0;    ///< points skipped because x, y or z was NaN / inf
+  int implausible = 0;   ///< points skipped because |x|, |y| or |z| > kMaxCoordinate
 };
 
-/// [m] A coordinate beyond this is no LiDAR return (e.g. 1e38 in a corrupt sweep): dropped, counted.
+/// [m] A coordinate beyond this is no LiDAR return (e.g. 1e38 in a corrupt sweep): dropped,
+/// counted.
 constexpr double kMaxCoordinate = 1e4;
 
 /// Checks the layout of a cloud without reading its points: x, y, z fields present as FLOAT32 or
-/// FLOAT64, the fields read (x, y, z, intensity, ring, the time fields) with count 1 and a numeric type,
-/// point_step / row_step / data size consistent, little-endian. Returns an empty string when
+/// FLOAT64, the fields read (x, y, z, intensity, ring, the time fields) with count 1 and a numeric
+/// type, point_step / row_step / data size consistent, little-endian. Returns an empty string when
 /// usable, else the problem.
 std::string checkCloudLayout(const sensor_msgs::PointCloud2& msg);
 
@@ -122,8 +123,8 @@ std::string checkCloudFieldTypes(const sensor_msgs::PointCloud2& msg);
 /// Reads a sweep as velodyne_pointcloud publishes it (x, y, z, intensity, ring, time) or any other
 /// layout with at least x, y, z. `intensity`, `ring` and the time fields (PointTimeField) are
 /// optional and may have any numeric datatype (float32/64, (u)int8/16/32). Non-finite points are
-/// skipped and counted; point times beyond `max_point_time` [s] of the stamp, or NaN, are counted in
-/// bad_times and not used. Throws ConversionError when checkCloudLayout() fails.
+/// skipped and counted; point times beyond `max_point_time` [s] of the stamp, or NaN, are counted
+/// in bad_times and not used. Throws ConversionError when checkCloudLayout() fails.
 CloudConversion cloudFromMsg(const sensor_msgs::PointCloud2& msg,
                              double max_point_time = kDefaultMaxPointTime);
 

@@ -13,8 +13,8 @@
 
 namespace lidar_stereo_fusion {
 
-/// For each time t [s] of `times` (relative to `sweep_stamp`), the transform from the LiDAR frame at
-/// sweep_stamp + t to the LiDAR frame at `target_stamp` (the left image's stamp), through
+/// For each time t [s] of `times` (relative to `sweep_stamp`), the transform from the LiDAR frame
+/// at sweep_stamp + t to the LiDAR frame at `target_stamp` (the left image's stamp), through
 /// `fixed_frame` (the frame in which the world stands still, e.g. odom or map). Throws
 /// tf2::TransformException when a lookup fails (missing frame, stale or future data); its what()
 /// names the frames and the stamp that failed.

@@ -42,6 +42,9 @@ struct NodeParams {
   double fresh_wait = 0.05;
   /// [s] wall time after which an input topic that sent nothing is warned about, by name (0 = off).
   double input_timeout = 5.0;
+  /// [s] wall time within which a warning of the same kind on the same topic is not repeated
+  /// (ThrottledLog); tests set it short instead of outwaiting it.
+  double log_throttle_period = 5.0;
   /// Nice increment of the worker thread (and so of the OpenMP threads it starts): the pipeline
   /// uses every core, and ROS callbacks, nodelet bond heartbeats and drivers in the same machine
   /// must still be served on time. 0 = same priority as the callbacks.
@@ -89,7 +92,8 @@ class ThrottledLog {
   enum class Level { kInfo, kWarn, kError };
   static constexpr std::size_t kMaxKeys = 64;
 
-  explicit ThrottledLog(std::string name, double period = 5.0)
+  /// `period` [s]: wall time within which a (topic, kind) is logged once (NodeParams default).
+  explicit ThrottledLog(std::string name, double period = NodeParams().log_throttle_period)
       : name_(std::move(name)), period_(period) {}
   void log(Level level, const std::string& topic, const std::string& kind, const std::string& text);
   void warn(const std::string& topic, const std::string& kind, const std::string& text) {

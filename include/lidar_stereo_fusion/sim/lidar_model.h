@@ -58,8 +58,8 @@ SimulatedSweep simulateSweep(const Scene& scene, const LidarModel& model,
 
 /// A sweep taken while the LiDAR moves, spinning clockwise seen from above as a Velodyne does: the
 /// firing at azimuth a (atan2(y, x) in (-180, 180] deg) happens at time
-/// t(a) = front_time - a / 360 deg * sweep_period [s] (straight ahead at front_time, the rear half a
-/// period before and after) and is cast from `pose_at(t)` (LiDAR frame -> street frame). Points
+/// t(a) = front_time - a / 360 deg * sweep_period [s] (straight ahead at front_time, the rear half
+/// a period before and after) and is cast from `pose_at(t)` (LiDAR frame -> street frame). Points
 /// are stored as by simulateSweep; a point's time is its t(a) [s], on the caller's time base.
 SimulatedSweep simulateMovingSweep(const Scene& scene, const LidarModel& model,
                                    const std::function<Eigen::Isometry3d(double)>& pose_at,

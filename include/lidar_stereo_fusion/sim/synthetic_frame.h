@@ -46,11 +46,12 @@ struct SyntheticParams {
   double frame_period = 0.1;    ///< [s] between frames (one LiDAR revolution)
   double camera_height = 1.65;  ///< above the street's ground [m]
   /// The LiDAR moves during its sweep: each firing is cast from the rig's pose at its own time, and
-  /// the LiDAR spins clockwise as a Velodyne does (sim::simulateMovingSweep). false: the whole sweep
-  /// is cast from the image instant's pose (a rig standing still, or a motion-compensated sweep).
+  /// the LiDAR spins clockwise as a Velodyne does (sim::simulateMovingSweep). false: the whole
+  /// sweep is cast from the image instant's pose (a rig standing still, or a motion-compensated
+  /// sweep).
   bool moving_sweep = false;
-  /// [s] with moving_sweep: the LiDAR faces straight ahead this long after the image instant (0: the
-  /// camera is triggered by the LiDAR, as KITTI's; a free-running ZED is up to a period away).
+  /// [s] with moving_sweep: the LiDAR faces straight ahead this long after the image instant (0:
+  /// the camera is triggered by the LiDAR, as KITTI's; a free-running ZED is up to a period away).
   double lidar_time_offset = 0.0;
 
   /// Throws std::invalid_argument naming the first impossible value.
