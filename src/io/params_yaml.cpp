@@ -173,7 +173,6 @@ std::string withYamlDirective(const std::string& text) {
   return "%YAML:1.0\n---\n" + text;
 }
 
-
 // ---- Writing --------------------------------------------------------------------------------
 
 class FieldWriter {

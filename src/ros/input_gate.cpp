@@ -38,10 +38,10 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
   using boost::placeholders::_2;
   using boost::placeholders::_3;
   using boost::placeholders::_4;
-  sync_ = std::make_unique<StereoSync>(
-      params_, sub_left_image_, sub_left_info_, sub_right_image_, sub_right_info_,
-      boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4),
-      boost::bind(&InputGate::syncDropCb, this, _1, _2, _3, _4));
+  sync_ = std::make_unique<StereoSync>(params_, sub_left_image_, sub_left_info_, sub_right_image_,
+                                       sub_right_info_,
+                                       boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4),
+                                       boost::bind(&InputGate::syncDropCb, this, _1, _2, _3, _4));
   // Every input topic's arrivals, for the watch (indices as in watch_'s list); the cloud's in
   // cloudCb.
   sub_left_image_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(

@@ -455,8 +455,8 @@ TEST(CostSimd, SidesAreTheShiftedPlanesCostsWhereTheOtherViewIsLinear) {
       cost.aggregateSides(cache, plane, step, lower, upper);
       const float exact_lower = cost.aggregate(cache, {a, b, plane.c - step}, inf);
       const float exact_upper = cost.aggregate(cache, {a, b, plane.c + step}, inf);
-      const auto where = ::testing::Message() << lsf::simdPathName(path) << " pixel " << px
-                                              << "," << py;
+      const auto where = ::testing::Message()
+                         << lsf::simdPathName(path) << " pixel " << px << "," << py;
       EXPECT_NEAR(lower, exact_lower, 1e-4 * exact_lower) << where;
       EXPECT_NEAR(upper, exact_upper, 1e-4 * exact_upper) << where;
     }

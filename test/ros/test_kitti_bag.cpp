@@ -40,8 +40,8 @@
 #include <tf2_msgs/TFMessage.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "data/data_guard.h"
 #include "bag_runner_check.h"
+#include "data/data_guard.h"
 #include "depth_agreement.h"
 #include "kitti_bag_expected.h"
 #include "kitti_bag_util.h"
@@ -511,7 +511,8 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
           ++disparity_off;
       }
     }
-    const auto agreement = lidar_stereo_fusion::test::agreeWithRunner(z_ros, z_runner, fx * baseline);
+    const auto agreement =
+        lidar_stereo_fusion::test::agreeWithRunner(z_ros, z_runner, fx * baseline);
     const int pixels = agreement.pixels, both = agreement.both;
     const int validity_differs = agreement.validity_differs, bad_1px = agreement.bad_1px;
     const double mean_abs = agreement.mean_abs;
@@ -524,8 +525,8 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
   }
   bag.close();
   lidar_stereo_fusion::test::expectBagRunnerAgrees(bag_path, scratchDir() + "/bag_runner", stamps,
-                                                  kReplayFrames, nodelet_depths, runner_out,
-                                                  fx * baseline);
+                                                   kReplayFrames, nodelet_depths, runner_out,
+                                                   fx * baseline);
 }
 
 int main(int argc, char** argv) {

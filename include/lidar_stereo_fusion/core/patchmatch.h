@@ -1,6 +1,6 @@
 // Stage 3: LiDAR-guided PatchMatch stereo with slanted support windows (Bleyer et al. 2011 with
-// the LiDAR disparity term of Xu et al.). Plain PMS is the mode gamma = 0, use_lidar_bounds = false,
-// init_from_prior = false.
+// the LiDAR disparity term of Xu et al.). Plain PMS is the mode gamma = 0, use_lidar_bounds =
+// false, init_from_prior = false.
 #pragma once
 
 #include <cstdint>
@@ -36,7 +36,7 @@ struct PatchMatchParams {
   /// samples a step, so 29 samples are 2 steps instead of 4 (about 20 % of the frame's time). On
   /// the accuracy protocols: KITTI hold-out MAE +2 %, Middlebury within 2 % (README).
   bool window_round = true;
-  double weight_delta = 10.0;    ///< delta of w = exp(-|I_p - I_p'|_1 / delta)
+  double weight_delta = 10.0;  ///< delta of w = exp(-|I_p - I_p'|_1 / delta)
   /// [px] sigma of a 3x3 Gaussian applied to both images before matching (0 = off). Linear
   /// interpolation of the other view at a sub-pixel match attenuates fine texture, which pulls
   /// the cost's minimum toward whole-pixel disparities ("pixel locking"); a band-limited image
@@ -48,26 +48,26 @@ struct PatchMatchParams {
   double alpha = 0.01;
   double beta = 0.09;
   double gamma = 0.9;
-  double lambda_col = 10.0;      ///< colour truncation (RGB L1 distance, 0..765 scale)
-  double lambda_grad = 2.0;      ///< gradient truncation
-  double lambda_disp = 2.0;      ///< disparity truncation [px]; also the cost where the prior is empty
+  double lambda_col = 10.0;  ///< colour truncation (RGB L1 distance, 0..765 scale)
+  double lambda_grad = 2.0;  ///< gradient truncation
+  double lambda_disp = 2.0;  ///< disparity truncation [px]; also the cost where the prior is empty
   int iterations = 2;
   /// Sweeps of the right view (the last min(k, iterations)); -1 = all (Bleyer). The right view
   /// serves view propagation and the left-right check and receives the left view's refined planes
   /// by view propagation before each of its sweeps; one sweep was as accurate on KITTI and
   /// Middlebury as three and saves ~40 % of the time.
   int right_iterations = 1;
-  bool slanted = true;           ///< false: front-parallel windows (n = (0, 0, 1))
-  bool init_from_prior = true;   ///< d = prior where it exists, else random
+  bool slanted = true;                 ///< false: front-parallel windows (n = (0, 0, 1))
+  bool init_from_prior = true;         ///< d = prior where it exists, else random
   bool init_normal_from_prior = true;  ///< slanted: initial normal from the prior's local slope
-  bool use_lidar_bounds = true;  ///< limit d to the scan lines above/below (+- bound_margin)
-  double bound_margin = 1.0;     ///< [px]
-  double min_refine_range = 0.5; ///< floor of Delta_d_max between scan lines [px]
-  double min_disparity = 1.0;    ///< image-wide search range [px]
-  double max_disparity = 192.0;  ///< [px]
+  bool use_lidar_bounds = true;        ///< limit d to the scan lines above/below (+- bound_margin)
+  double bound_margin = 1.0;           ///< [px]
+  double min_refine_range = 0.5;       ///< floor of Delta_d_max between scan lines [px]
+  double min_disparity = 1.0;          ///< image-wide search range [px]
+  double max_disparity = 192.0;        ///< [px]
   bool view_propagation = true;
-  bool lr_check = true;          ///< left-right consistency + hole filling + weighted median
-  double lr_max_diff = 1.0;      ///< [px]
+  bool lr_check = true;      ///< left-right consistency + hole filling + weighted median
+  double lr_max_diff = 1.0;  ///< [px]
   /// Half window [px] of the weighted median over filled pixels (sampled every 2nd pixel). Plain
   /// PMS uses its matching window (Bleyer); the fused method 11x11, which was as accurate as its
   /// 17x17 matching window on every protocol and cheaper.
@@ -146,7 +146,7 @@ struct PatchMatchParams {
   /// the sub-pixel step alone polishes them (half the cost evaluations of the levels; KITTI and
   /// Middlebury within a few per cent either way).
   bool fine_refine = false;
-  int num_threads = 0;           ///< 0 = all cores (at most 256)
+  int num_threads = 0;  ///< 0 = all cores (at most 256)
   uint64_t seed = 42;
   /// The cost kernels' instructions (patchmatch/simd.h): every path gives the same result, only
   /// the speed differs. Not a tunable parameter (not in the parameter table): a value the caller
@@ -158,11 +158,11 @@ struct PatchMatchParams {
 
 /// Output of PatchMatch for the left view.
 struct PatchMatchResult {
-  cv::Mat1f disparity;      ///< dense left disparity [px], 0 where nothing could be filled
+  cv::Mat1f disparity;        ///< dense left disparity [px], 0 where nothing could be filled
   cv::Mat1f right_disparity;  ///< right view disparity [px] (when computed)
-  cv::Mat1b inconsistent;   ///< 255 where the left-right check failed (then filled)
-  cv::Mat3f planes;         ///< per-pixel plane (a, b, c): d = a x + b y + c
-  cv::Mat3f right_planes;   ///< the same for the right view (when computed)
+  cv::Mat1b inconsistent;     ///< 255 where the left-right check failed (then filled)
+  cv::Mat3f planes;           ///< per-pixel plane (a, b, c): d = a x + b y + c
+  cv::Mat3f right_planes;     ///< the same for the right view (when computed)
 };
 
 /// Inputs of one view.
@@ -175,11 +175,11 @@ struct ViewInput {
         bounds(std::move(bounds_)),
         confidence(std::move(confidence_)) {}
 
-  cv::Mat image;            ///< BGR CV_8UC3 (or grey CV_8UC1) rectified image
-  cv::Mat1f prior;          ///< up-sampled LiDAR disparity of this view, 0 = empty (may be empty())
-  ScanLineBounds bounds;    ///< search bounds from the scan lines (may be empty())
-  cv::Mat1f confidence;     ///< confidence of the prior in [0, 1] (may be empty(): 1 where the
-                            ///< prior has a value)
+  cv::Mat image;          ///< BGR CV_8UC3 (or grey CV_8UC1) rectified image
+  cv::Mat1f prior;        ///< up-sampled LiDAR disparity of this view, 0 = empty (may be empty())
+  ScanLineBounds bounds;  ///< search bounds from the scan lines (may be empty())
+  cv::Mat1f confidence;   ///< confidence of the prior in [0, 1] (may be empty(): 1 where the
+                          ///< prior has a value)
 };
 
 /// Runs guided PatchMatch. Scratch buffers (images as float, planes, costs) are reused across
@@ -199,7 +199,7 @@ class PatchMatchStereo {
   struct Scratch;
   std::shared_ptr<Scratch> scratch_;
   std::shared_ptr<PatchMatchStereo> coarse_;  ///< the coarse start's solver (coarse_scale > 1)
-  bool intermediate_ = false;  ///< a reduced level of another solver's coarse start
+  bool intermediate_ = false;                 ///< a reduced level of another solver's coarse start
 
   // compute()'s stages, in order (patchmatch.cpp): prepare the views, start from the coarse
   // start's planes, search each view (initialisation, propagation, refinement, view propagation),

@@ -64,7 +64,7 @@ PatchMatchParams coarseParams(const PatchMatchParams& p) {
   c.unbounded_scale = std::max(1, p.unbounded_scale / s);
   c.full_size_unbounded = true;
   c.fine_right_view = true;
-  c.fine_subpixel = false;       // ... and the sub-pixel step belongs to the full size
+  c.fine_subpixel = false;  // ... and the sub-pixel step belongs to the full size
   return c;
 }
 

@@ -166,8 +166,7 @@ PhiWeights MatchingCost::phiWeights(float w, float trust) const {
   }
   // The paper: phi = rho_img + gamma rho_lid, or + gamma lambda_disp without a prior.
   const bool measured = trust > 0.f;
-  return PhiWeights{w, measured ? w * wg_ : 0.f,
-                    use_prior_ && !measured ? w * wg_ * ldisp_ : 0.f};
+  return PhiWeights{w, measured ? w * wg_ : 0.f, use_prior_ && !measured ? w * wg_ * ldisp_ : 0.f};
 }
 
 float MatchingCost::supportWeight(float l1) const {
@@ -181,13 +180,13 @@ void MatchingCost::buildWindow(int px, int py, WindowCache& cache) const {
     buildWindowBaseline(px, py, cache);
     return;
   }
-  const KernelWindowOut out{cache.xs.data(),      cache.ys.data(),     cache.w_img.data(),
-                            cache.w_lidar.data(), cache.priors.data(), cache.texels.data()->v,
+  const KernelWindowOut out{cache.xs.data(),       cache.ys.data(),     cache.w_img.data(),
+                            cache.w_lidar.data(),  cache.priors.data(), cache.texels.data()->v,
                             cache.texel_row.data()};
   cache.count = buildWindowAvx2(kernel_self_, px, py, out, cache.padded, cache.constant);
-  cache.kernel = KernelWindow{cache.xs.data(),      cache.ys.data(),     cache.w_img.data(),
-                              cache.w_lidar.data(), cache.priors.data(), cache.texels.data()->v,
-                              cache.texel_row.data(), cache.padded,      cache.count,
+  cache.kernel = KernelWindow{cache.xs.data(),        cache.ys.data(),     cache.w_img.data(),
+                              cache.w_lidar.data(),   cache.priors.data(), cache.texels.data()->v,
+                              cache.texel_row.data(), cache.padded,        cache.count,
                               cache.constant};
 }
 
@@ -235,8 +234,7 @@ void MatchingCost::aggregateSides(const WindowCache& cache, const Plane& plane, 
     return;
   }
   if (avx2_) {
-    aggregateSidesAvx2(cache.kernel, kernel_, plane.a, plane.b, plane.c, h, shift_q, lower,
-                       upper);
+    aggregateSidesAvx2(cache.kernel, kernel_, plane.a, plane.b, plane.c, h, shift_q, lower, upper);
     return;
   }
   aggregateSidesImpl(cache, plane, h, shift_q, lower, upper);

@@ -66,9 +66,9 @@ inline __m256i pairOf(const short* v, int p) {
 inline __m256i pairFraction(__m256i fractions, int p) {
   const char lo = static_cast<char>(2 * p), hi = static_cast<char>(2 * p + 1);
   const char lo4 = static_cast<char>(2 * p + 8), hi4 = static_cast<char>(2 * p + 9);
-  const __m256i select = _mm256_setr_epi8(lo, hi, lo, hi, lo, hi, lo, hi, lo, hi, lo, hi, lo, hi,
-                                          lo, hi, lo4, hi4, lo4, hi4, lo4, hi4, lo4, hi4, lo4, hi4,
-                                          lo4, hi4, lo4, hi4, lo4, hi4);
+  const __m256i select =
+      _mm256_setr_epi8(lo, hi, lo, hi, lo, hi, lo, hi, lo, hi, lo, hi, lo, hi, lo, hi, lo4, hi4,
+                       lo4, hi4, lo4, hi4, lo4, hi4, lo4, hi4, lo4, hi4, lo4, hi4, lo4, hi4);
   return _mm256_shuffle_epi8(fractions, select);
 }
 
@@ -137,11 +137,9 @@ inline __m256i pairDifference(const short* other, const int* node, const short* 
 /// The image term of 8 samples: alpha min(col, lambda_col) + beta min(grad, lambda_grad), or the
 /// outside cost where the match left the image.
 inline __m256 imageTerm(const KernelConstants& k, __m256 col, __m256 grad, __m256 inside) {
-  const __m256 rho =
-      _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(k.alpha),
-                                  _mm256_min_ps(col, _mm256_set1_ps(k.lambda_col))),
-                    _mm256_mul_ps(_mm256_set1_ps(k.beta),
-                                  _mm256_min_ps(grad, _mm256_set1_ps(k.lambda_grad))));
+  const __m256 rho = _mm256_add_ps(
+      _mm256_mul_ps(_mm256_set1_ps(k.alpha), _mm256_min_ps(col, _mm256_set1_ps(k.lambda_col))),
+      _mm256_mul_ps(_mm256_set1_ps(k.beta), _mm256_min_ps(grad, _mm256_set1_ps(k.lambda_grad))));
   return _mm256_blendv_ps(_mm256_set1_ps(k.outside_cost), rho, inside);
 }
 
@@ -196,8 +194,9 @@ int gatherSamples(const KernelSelf& s, int px, int py, const KernelWindowOut& ou
     const short* texel_row = texels + (static_cast<long>(y) * s.width + px) * kTexelChannels;
     __m128i* own = reinterpret_cast<__m128i*>(out.texels + k * kTexelChannels);
     const auto copy_texel = [&](int j, int col) {
-      _mm_store_si128(own + j, _mm_load_si128(reinterpret_cast<const __m128i*>(
-                                   texel_row + col * kTexelChannels)));
+      _mm_store_si128(
+          own + j,
+          _mm_load_si128(reinterpret_cast<const __m128i*>(texel_row + col * kTexelChannels)));
     };
     float* priors = out.priors + k;
     float* trusts = out.w_lidar + k;
@@ -300,8 +299,8 @@ void interiorWindow(const KernelSelf& s, int px, int py, const KernelWindowOut& 
     _mm256_storeu_ps(out.ys + b, _mm256_add_ps(fy, _mm256_loadu_ps(s.interior_dy + b)));
     _mm256_storeu_si256(
         reinterpret_cast<__m256i*>(out.texel_row + b),
-        _mm256_add_epi32(row, _mm256_loadu_si256(
-                                  reinterpret_cast<const __m256i*>(s.interior_row + b))));
+        _mm256_add_epi32(row,
+                         _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s.interior_row + b))));
     const int* at = s.interior_texel + b;
     __m128i* own = reinterpret_cast<__m128i*>(out.texels + b * kTexelChannels);
     __m256i pairs[kPairs];
@@ -393,8 +392,8 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
   return w.constant + laneSum(acc);
 }
 
-void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b,
-                        float c, float h, int shift_q, float& lower, float& upper) {
+void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b, float c,
+                        float h, int shift_q, float& lower, float& upper) {
   const __m256 va = _mm256_set1_ps(a), vb = _mm256_set1_ps(b), vc = _mm256_set1_ps(c);
   const __m256 vh = _mm256_set1_ps(h), ldisp = _mm256_set1_ps(k.lambda_disp);
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
@@ -421,10 +420,10 @@ void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a
     const __m256 rho_upper = imageTerm(k, col_upper, grad_upper, m.inside);
     const __m256 prior = _mm256_loadu_ps(w.priors + s);
     const __m256 w_img = _mm256_loadu_ps(w.w_img + s), w_lidar = _mm256_loadu_ps(w.w_lidar + s);
-    const __m256 lid_lower = _mm256_min_ps(
-        _mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_sub_ps(m.d, vh))), ldisp);
-    const __m256 lid_upper = _mm256_min_ps(
-        _mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_add_ps(m.d, vh))), ldisp);
+    const __m256 lid_lower =
+        _mm256_min_ps(_mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_sub_ps(m.d, vh))), ldisp);
+    const __m256 lid_upper =
+        _mm256_min_ps(_mm256_and_ps(abs_mask, _mm256_sub_ps(prior, _mm256_add_ps(m.d, vh))), ldisp);
     acc_lower = _mm256_add_ps(acc_lower, _mm256_add_ps(_mm256_mul_ps(w_img, rho_lower),
                                                        _mm256_mul_ps(w_lidar, lid_lower)));
     acc_upper = _mm256_add_ps(acc_upper, _mm256_add_ps(_mm256_mul_ps(w_img, rho_upper),

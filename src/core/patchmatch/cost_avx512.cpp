@@ -11,8 +11,7 @@
 // texels of a group are one load.
 #include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
 
-#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512VL__) && \
-    defined(__AVX512DQ__)
+#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512VL__) && defined(__AVX512DQ__)
 
 #include <immintrin.h>
 
@@ -82,12 +81,12 @@ inline __m512i groupDifference(const short* other, const int* node, const short*
   slope = _mm512_sub_epi16(t1, t0);
   // Sample 4 g + q's fraction over the 8 channels of quarter q.
   const short f0 = static_cast<short>(g * kGroup);
-  const __m512i pick = _mm512_set_epi16(
-      f0 + 3, f0 + 3, f0 + 3, f0 + 3, f0 + 3, f0 + 3, f0 + 3, f0 + 3, f0 + 2, f0 + 2, f0 + 2,
-      f0 + 2, f0 + 2, f0 + 2, f0 + 2, f0 + 2, f0 + 1, f0 + 1, f0 + 1, f0 + 1, f0 + 1, f0 + 1,
-      f0 + 1, f0 + 1, f0, f0, f0, f0, f0, f0, f0, f0);
-  const __m512i m = _mm512_add_epi16(
-      t0, _mm512_mulhrs_epi16(slope, _mm512_permutexvar_epi16(pick, fractions)));
+  const __m512i pick = _mm512_set_epi16(f0 + 3, f0 + 3, f0 + 3, f0 + 3, f0 + 3, f0 + 3, f0 + 3,
+                                        f0 + 3, f0 + 2, f0 + 2, f0 + 2, f0 + 2, f0 + 2, f0 + 2,
+                                        f0 + 2, f0 + 2, f0 + 1, f0 + 1, f0 + 1, f0 + 1, f0 + 1,
+                                        f0 + 1, f0 + 1, f0 + 1, f0, f0, f0, f0, f0, f0, f0, f0);
+  const __m512i m =
+      _mm512_add_epi16(t0, _mm512_mulhrs_epi16(slope, _mm512_permutexvar_epi16(pick, fractions)));
   diff = _mm512_sub_epi16(_mm512_loadu_si512(own + g * kGroup * kTexelChannels), m);
   return _mm512_abs_epi16(diff);
 }
@@ -114,11 +113,9 @@ inline void channelSums(const __m512i* group_sums, __m512& col, __m512& grad) {
 /// alpha min(col, lambda_col) + beta min(grad, lambda_grad), or the outside cost where the match
 /// left the image.
 inline __m512 imageTerm(const KernelConstants& k, __m512 col, __m512 grad, __mmask16 inside) {
-  const __m512 rho =
-      _mm512_add_ps(_mm512_mul_ps(_mm512_set1_ps(k.alpha),
-                                  _mm512_min_ps(col, _mm512_set1_ps(k.lambda_col))),
-                    _mm512_mul_ps(_mm512_set1_ps(k.beta),
-                                  _mm512_min_ps(grad, _mm512_set1_ps(k.lambda_grad))));
+  const __m512 rho = _mm512_add_ps(
+      _mm512_mul_ps(_mm512_set1_ps(k.alpha), _mm512_min_ps(col, _mm512_set1_ps(k.lambda_col))),
+      _mm512_mul_ps(_mm512_set1_ps(k.beta), _mm512_min_ps(grad, _mm512_set1_ps(k.lambda_grad))));
   return _mm512_mask_blend_ps(inside, _mm512_set1_ps(k.outside_cost), rho);
 }
 
@@ -222,12 +219,12 @@ void aggregateSidesAvx512(const KernelWindow& w, const KernelConstants& k, float
     const __m512 w_lidar = _mm512_maskz_loadu_ps(lanes, w.w_lidar + s);
     const __m512 lid_lower = lidarTerm(prior, _mm512_sub_ps(m.d, vh), ldisp);
     const __m512 lid_upper = lidarTerm(prior, _mm512_add_ps(m.d, vh), ldisp);
-    acc_lower = addTerms(acc_lower, _mm512_add_ps(_mm512_mul_ps(w_img, rho_lower),
-                                                  _mm512_mul_ps(w_lidar, lid_lower)),
-                         wide);
-    acc_upper = addTerms(acc_upper, _mm512_add_ps(_mm512_mul_ps(w_img, rho_upper),
-                                                  _mm512_mul_ps(w_lidar, lid_upper)),
-                         wide);
+    acc_lower = addTerms(
+        acc_lower,
+        _mm512_add_ps(_mm512_mul_ps(w_img, rho_lower), _mm512_mul_ps(w_lidar, lid_lower)), wide);
+    acc_upper = addTerms(
+        acc_upper,
+        _mm512_add_ps(_mm512_mul_ps(w_img, rho_upper), _mm512_mul_ps(w_lidar, lid_upper)), wide);
   }
   lower = w.constant + laneSum(acc_lower);
   upper = w.constant + laneSum(acc_upper);
@@ -247,8 +244,8 @@ float aggregateAvx512(const KernelWindow& w, const KernelConstants&, float, floa
   return w.constant;
 }
 
-void aggregateSidesAvx512(const KernelWindow& w, const KernelConstants&, float, float, float,
-                          float, int, float& lower, float& upper) {
+void aggregateSidesAvx512(const KernelWindow& w, const KernelConstants&, float, float, float, float,
+                          int, float& lower, float& upper) {
   lower = upper = w.constant;
 }
 

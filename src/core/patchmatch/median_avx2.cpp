@@ -22,8 +22,8 @@ float weightedMedianAvx2(const float* d, const float* w, int n, int padded, floa
   const __m256 vhalf = _mm256_set1_ps(half), largest = _mm256_set1_ps(__FLT_MAX__);
   __m256 best = largest;
   for (int i0 = 0; i0 < padded; i0 += kGroups * kMedianLanes) {
-    const int groups = (padded - i0) / kMedianLanes < kGroups ? (padded - i0) / kMedianLanes
-                                                               : kGroups;
+    const int groups =
+        (padded - i0) / kMedianLanes < kGroups ? (padded - i0) / kMedianLanes : kGroups;
     __m256 candidate[kGroups], cumulative[kGroups];
     for (int g = 0; g < kGroups; ++g) {
       // Groups past the padding repeat the last one: the same sums, the same minimum.

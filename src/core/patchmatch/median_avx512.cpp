@@ -4,8 +4,7 @@
 // (a lane not below adds nothing, where the other paths add 0 to a sum that is never -0).
 #include "lidar_stereo_fusion/core/patchmatch/median_kernel.h"
 
-#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512VL__) && \
-    defined(__AVX512DQ__)
+#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512VL__) && defined(__AVX512DQ__)
 
 #include <immintrin.h>
 

@@ -8,7 +8,8 @@
 //   startFromLevelBelow  coarse start: the planes of the level below, up-sampled, and its
 //                        left-right check (checkLevelBelow, skipInconsistent)
 //   searchViews          initialisation, then per iteration the left view's sweep and the right
-//                        view's (searchRightView: view propagation in, sweep, view propagation back)
+//                        view's (searchRightView: view propagation in, sweep, view propagation
+//                        back)
 //   postProcess          disparities, left-right check (consistencyCheck), hole filling
 //
 // Per iteration: left view sweep. In the last `right_iterations` iterations also: view
@@ -86,7 +87,7 @@ struct PatchMatchStereo::Level {
   bool unmatched_bad = false;  ///< the left-right check marks the pixels without a match
   int iterations = 0;
   int threads = 1;
-  cv::Mat1b inconsistent;      ///< the left-right check's mask, where it is the level below's
+  cv::Mat1b inconsistent;  ///< the left-right check's mask, where it is the level below's
 };
 
 /// Per-object buffers reused across frames (a fresh full-size buffer costs page faults every
@@ -110,9 +111,10 @@ PatchMatchResult PatchMatchStereo::levelBelow(const ViewInput& left, const ViewI
   }
   coarse_->setParams(patchmatch::coarseParams(p));
   ViewInput coarse_left, coarse_right;
-  bothViews(patchmatch::threadCount(p),
-            [&] { coarse_left = patchmatch::downsampleView(left, p.coarse_scale); },
-            [&] { coarse_right = patchmatch::downsampleView(right, p.coarse_scale); });
+  bothViews(
+      patchmatch::threadCount(p),
+      [&] { coarse_left = patchmatch::downsampleView(left, p.coarse_scale); },
+      [&] { coarse_right = patchmatch::downsampleView(right, p.coarse_scale); });
   return coarse_->compute(coarse_left, coarse_right);
 }
 
@@ -129,8 +131,8 @@ PatchMatchResult PatchMatchStereo::upsampledResult(const ViewInput& left, const 
   PatchMatchResult result;
   result.planes.create(size);
   result.disparity.create(size);
-  result.inconsistent = p.lr_check ? upsampleMask(below.inconsistent, s, size)
-                                   : cv::Mat1b(size, uchar(0));
+  result.inconsistent =
+      p.lr_check ? upsampleMask(below.inconsistent, s, size) : cv::Mat1b(size, uchar(0));
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int y = 0; y < size.height; ++y) {
     for (int x = 0; x < size.width; ++x) {
@@ -172,15 +174,15 @@ PatchMatchStereo::Level PatchMatchStereo::prepareLevel(const ViewInput& left,
   level.size = left.image.size();
   level.guided = guided;
   level.threads = patchmatch::threadCount(p);
-  bothViews(level.threads, [&] { patchmatch::prepareView(left, p, -1.f, scratch_->left); },
-            [&] { patchmatch::prepareView(right, p, +1.f, scratch_->right); });
+  bothViews(
+      level.threads, [&] { patchmatch::prepareView(left, p, -1.f, scratch_->left); },
+      [&] { patchmatch::prepareView(right, p, +1.f, scratch_->right); });
   level.iterations = guided ? p.fine_iterations : p.iterations;
   level.unmatched_bad = p.confidence_weighting && !scratch_->left.prior.empty();
   // Whether the full-size right view is searched: without a coarse start always; after one for
   // Bleyer's right view (fine_right_view) or a full-size left-right check (fine_lr_check).
   const bool two_views = p.view_propagation || p.lr_check;
-  level.right_view =
-      two_views && (!guided || p.fine_right_view || (p.lr_check && p.fine_lr_check));
+  level.right_view = two_views && (!guided || p.fine_right_view || (p.lr_check && p.fine_lr_check));
   return level;
 }
 
@@ -252,9 +254,8 @@ void PatchMatchStereo::searchViews(const Level& level) {
   // propagation and the left-right check; view propagation runs around its sweeps (left -> right
   // before, right -> left after), since in the other iterations the right view would only hand
   // the left view's own planes back.
-  const int right_iterations = p.right_iterations < 0
-                                   ? level.iterations
-                                   : std::min(p.right_iterations, level.iterations);
+  const int right_iterations =
+      p.right_iterations < 0 ? level.iterations : std::min(p.right_iterations, level.iterations);
   for (int it = 0; it < level.iterations; ++it) {
     sweep(left_search, lv, p, it);
     if (!level.right_view || it < level.iterations - right_iterations) continue;

@@ -152,8 +152,8 @@ int medianWindow(const ViewState& v, const cv::Mat1f& filled, int x, int y, int 
       const float d = frow[xx];
       if (d <= 0.f) continue;
       const cv::Vec3f& q = crow[xx];
-      const int l1 = static_cast<int>(std::abs(q[0] - c[0]) + std::abs(q[1] - c[1]) +
-                                      std::abs(q[2] - c[2]));
+      const int l1 =
+          static_cast<int>(std::abs(q[0] - c[0]) + std::abs(q[1] - c[1]) + std::abs(q[2] - c[2]));
       const float w = lut[std::min(l1, lut_last)];
       ds[n] = d;
       ws[n++] = w;
@@ -203,8 +203,8 @@ void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, in
   }
 }
 
-void fillHoles(const ViewState& v, cv::Mat1b bad, const FillOptions& options,
-               cv::Mat1f& disparity, int threads) {
+void fillHoles(const ViewState& v, cv::Mat1b bad, const FillOptions& options, cv::Mat1f& disparity,
+               int threads) {
   fillFromPrior(v, bad, options.fill_trust, disparity, threads);
   cv::Mat1f filled = disparity.clone();
 #pragma omp parallel for schedule(dynamic, 4) num_threads(threads)

@@ -22,9 +22,9 @@ bool detectAvx512() {
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
   // libgcc reports AVX-512 features only where XGETBV says the OS saves the 512-bit state.
   __builtin_cpu_init();
-  return patchmatch::kAvx512KernelBuilt && cpuHasAvx2Fma() &&
-         __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
-         __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq");
+  return patchmatch::kAvx512KernelBuilt && cpuHasAvx2Fma() && __builtin_cpu_supports("avx512f") &&
+         __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl") &&
+         __builtin_cpu_supports("avx512dq");
 #else
   return false;
 #endif

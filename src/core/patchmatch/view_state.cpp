@@ -191,7 +191,7 @@ void setGuide(std::vector<Plane> guide, const PatchMatchParams& p, ViewState& v)
   v.guide = std::move(guide);
   // A level finer than unbounded_scale takes the level below's plane as it is; else, without
   // full_size_unbounded, it polishes that plane.
-  const uint8_t settle = p.unbounded_scale > 1    ? kKeptFromGuide
+  const uint8_t settle = p.unbounded_scale > 1   ? kKeptFromGuide
                          : p.full_size_unbounded ? uint8_t{0}
                                                  : kSettledByGuide;
   if (settle == 0) return;

@@ -65,11 +65,11 @@ struct KernelSelf {
   int offset_count;
   /// Row i of the window holds the columns [row_first[i], row_end[i]) (WindowRows, cost.h).
   const int *row_first, *row_end;
-  int sample_count;  ///< samples of a window wholly inside the image
+  int sample_count;         ///< samples of a window wholly inside the image
   const float* weight_lut;  ///< w by L1 colour distance times lut_scale
   int lut_size;
   float lut_scale;  ///< LUT entries per unit of RGB L1 distance
-  bool weighted;  ///< confidence-weighted phi (else the paper's)
+  bool weighted;    ///< confidence-weighted phi (else the paper's)
   float gamma, img_norm, lambda_disp;
   /// The samples of a window wholly inside the image, in the window's order and padded to a
   /// multiple of kSimdBlock with the first sample, as offsets from the centre: dx, dy [px], dy
@@ -109,8 +109,8 @@ float aggregateAvx2(const KernelWindow& w, const KernelConstants& k, float a, fl
 /// interval of d's match (linear in the shift, exact where the other view is linear there), in
 /// one pass: MatchingCost::aggregateSides; shift_q = round(sign h 2^15), the match's move in
 /// the fixed point of the fraction. Summed like C, no bound. Call only with AVX2 + FMA.
-void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b,
-                        float c, float h, int shift_q, float& lower, float& upper);
+void aggregateSidesAvx2(const KernelWindow& w, const KernelConstants& k, float a, float b, float c,
+                        float h, int shift_q, float& lower, float& upper);
 
 /// True when cost_avx512.cpp was compiled with AVX-512 F, BW, VL and DQ (x86 builds).
 extern const bool kAvx512KernelBuilt;

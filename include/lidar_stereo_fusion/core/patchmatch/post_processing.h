@@ -47,8 +47,8 @@ struct FillOptions {
 /// (background) disparity of the nearest consistent planes left and right (of those not above
 /// max_disparity, the configured search range, at the pixel), then a colour-weighted median over
 /// the window of radius `radius` (every second row and column; weights exp(-L1 colour / delta)).
-void fillHoles(const ViewState& v, cv::Mat1b bad, const FillOptions& options,
-               cv::Mat1f& disparity, int threads);
+void fillHoles(const ViewState& v, cv::Mat1b bad, const FillOptions& options, cv::Mat1f& disparity,
+               int threads);
 
 }  // namespace patchmatch
 }  // namespace lidar_stereo_fusion
