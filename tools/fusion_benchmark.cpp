@@ -215,7 +215,7 @@ int run(const Options& o) {
   if (!o.method.empty()) params.method = lsf::parseMethod(o.method);
   params.patchmatch.num_threads = o.threads;
   lsf::applySimdEnvironment(params);
-  const int threads = o.threads > 0 ? o.threads : omp_get_num_procs();
+  const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
   omp_set_num_threads(threads);
   cv::setNumThreads(threads);
   params.validate();

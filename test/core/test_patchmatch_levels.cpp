@@ -160,7 +160,9 @@ TEST(PatchMatchCoarseStart, AtUnboundedScale2StereoOnlyPixelsAreTheHalfSizePlane
         same += q[0] == e.a && q[1] == e.b && q[2] == e.c;
       }
     }
-    if (intermediate_refine) EXPECT_EQ(same, 96 * 48);
+    if (intermediate_refine) {
+      EXPECT_EQ(same, 96 * 48);
+    }
     // The slanted plane is found either way (d = 6 + 0.05 x), less precisely than at full size
     // (0.17 px mean error; 0.31 px when the 1/2 level only propagates).
     double error = 0.0;

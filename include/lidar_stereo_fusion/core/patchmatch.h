@@ -146,7 +146,7 @@ struct PatchMatchParams {
   /// the sub-pixel step alone polishes them (half the cost evaluations of the levels; KITTI and
   /// Middlebury within a few per cent either way).
   bool fine_refine = false;
-  int num_threads = 0;  ///< 0 = all cores (at most 256)
+  int num_threads = 0;  ///< 0 = all cores, or OMP_NUM_THREADS when set (at most 256)
   uint64_t seed = 42;
   /// The cost kernels' instructions (patchmatch/simd.h): every path gives the same result, only
   /// the speed differs. Not a tunable parameter (not in the parameter table): a value the caller

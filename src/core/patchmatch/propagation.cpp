@@ -255,7 +255,9 @@ void PlaneSearch::subpixelStep(int x, int y, const WindowCache& cache, Plane& be
 }
 
 int threadCount(const PatchMatchParams& p) {
-  return p.num_threads > 0 ? p.num_threads : omp_get_num_procs();
+  // 0: OpenMP's default team, i.e. every core unless OMP_NUM_THREADS says otherwise (lsf_batch
+  // runs one bag_runner per worker with OMP_NUM_THREADS = --threads-per-worker).
+  return p.num_threads > 0 ? p.num_threads : omp_get_max_threads();
 }
 
 void initialise(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int view) {
