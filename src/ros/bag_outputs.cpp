@@ -13,7 +13,6 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "lidar_stereo_fusion/core/depth.h"
-#include "lidar_stereo_fusion/core/motion_compensation.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/pcd.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
@@ -97,12 +96,10 @@ FusedSet fuseSet(const InputMatch& match, const Eigen::Isometry3d& T_cam_lidar,
   out.rings = ensureRings(cloud.cloud, cloud.has_ring, node_params.num_rings);
   if (!node_params.fixed_frame.empty()) {  // as FusionWorker::compensateEgoMotion
     try {
-      compensateMotion(cloud.cloud,
-                       sweepMotionFromTf(tf, match.sweep->header.frame_id, node_params.fixed_frame,
-                                         match.sweep_stamp, match.image_stamp,
-                                         motionSampleTimes(cloud.cloud, cloud.has_time,
-                                                           node_params.motion_samples)));
-      removePointsHiddenBeside(cloud.cloud, input.T_cam_lidar, input.camera);
+      compensateSweep(tf, match.sweep->header.frame_id, node_params.fixed_frame, match.sweep_stamp,
+                      match.image_stamp,
+                      motionSampleTimes(cloud.cloud, cloud.has_time, node_params.motion_samples),
+                      input.T_cam_lidar, input.camera, cloud.cloud);
       out.motion_compensated = true;
     } catch (const tf2::TransformException& e) {
       if (node_params.motion_failure == "skip") {

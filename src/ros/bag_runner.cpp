@@ -24,6 +24,7 @@
 #include "lidar_stereo_fusion/io/report.h"
 #include "lidar_stereo_fusion/ros/bag_outputs.h"
 #include "lidar_stereo_fusion/ros/bag_pairing.h"
+#include "lidar_stereo_fusion/ros/ego_motion.h"
 
 namespace lsf = lidar_stereo_fusion;
 namespace fs = std::filesystem;
@@ -250,16 +251,16 @@ void Runner::finishSet(lsf::SetOutcome& s, lsf::FusionPipeline& pipeline,
   std::string reason;
   try {
     Eigen::Isometry3d T;
+    const ros::Time at =
+        lsf::extrinsicsStamp(node_params_.fixed_frame, match.sweep_stamp, match.image_stamp);
     try {
-      // At the image stamp when the sweep is moved there (~fixed_frame), as the nodelet does.
-      T = tf2::transformToEigen(pairing_->tf().lookupTransform(
-          camera_frame, lidar_frame,
-          node_params_.fixed_frame.empty() ? match.sweep_stamp : match.image_stamp));
+      T = tf2::transformToEigen(pairing_->tf().lookupTransform(camera_frame, lidar_frame, at));
     } catch (const tf2::TransformException& e) {
       throw std::runtime_error("no transform from '" + lidar_frame + "' (" + o_.topics.cloud +
                                ") to '" + camera_frame + "' (" + o_.topics.left_image +
-                               ") at the sweep stamp " + lsf::stampName(match.sweep_stamp) +
-                               " in /tf_static or /tf: " + e.what());
+                               ") at the " +
+                               (node_params_.fixed_frame.empty() ? "sweep" : "image") + " stamp " +
+                               lsf::stampName(at) + " in /tf_static or /tf: " + e.what());
     }
     const lsf::FusedSet set = lsf::fuseSet(match, T, pipeline, node_params_, pairing_->tf());
     if (!set.motion_failure.empty()) {

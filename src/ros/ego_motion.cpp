@@ -24,6 +24,18 @@ SweepMotion sweepMotionFromTf(const tf2::BufferCore& tf, const std::string& lida
   return motion;
 }
 
+void compensateSweep(const tf2::BufferCore& tf, const std::string& lidar_frame,
+                     const std::string& fixed_frame, const ros::Time& sweep_stamp,
+                     const ros::Time& image_stamp, const std::vector<double>& times,
+                     const Eigen::Isometry3d& T_cam_lidar, const StereoCamera& camera,
+                     LidarCloud& cloud) {
+  const SweepMotion motion =
+      sweepMotionFromTf(tf, lidar_frame, fixed_frame, sweep_stamp, image_stamp, times);
+  compensateMotion(cloud, motion);
+  // Measured from elsewhere than the camera: what it cannot see beside near objects goes.
+  removePointsHiddenBeside(cloud, T_cam_lidar, camera);
+}
+
 std::vector<double> motionSampleTimes(const LidarCloud& cloud, bool has_time, int samples) {
   if (!has_time || cloud.empty()) return {0.0};
   const auto [first, last] = timeSpan(cloud);

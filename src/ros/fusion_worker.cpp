@@ -15,7 +15,6 @@
 #include <boost/bind/bind.hpp>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
-#include "lidar_stereo_fusion/core/motion_compensation.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
 #include "lidar_stereo_fusion/ros/ego_motion.h"
@@ -167,7 +166,7 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   // Extrinsics at the sweep stamp, or at the image stamp the points are moved to with
   // ~fixed_frame; a short timeout bounds the wait (worker thread only).
   const ros::Time extrinsics_stamp =
-      node_params_.fixed_frame.empty() ? match.sweep_stamp : match.image_stamp;
+      extrinsicsStamp(node_params_.fixed_frame, match.sweep_stamp, match.image_stamp);
   FusionInput input;
   try {
     const geometry_msgs::TransformStamped tf = tf_buffer_.lookupTransform(
@@ -279,10 +278,8 @@ bool FusionWorker::compensateEgoMotion(const InputMatch& match, const FusionInpu
                                     "' at " + stampText(latest) + " within " +
                                     std::to_string(node_params_.tf_timeout) + " s: " + why);
     }
-    compensateMotion(cloud.cloud, sweepMotionFromTf(tf_buffer_, lidar_frame, fixed_frame,
-                                                    match.sweep_stamp, match.image_stamp, times));
-    // Measured from elsewhere than the camera: what it cannot see beside near objects goes.
-    removePointsHiddenBeside(cloud.cloud, input.T_cam_lidar, input.camera);
+    compensateSweep(tf_buffer_, lidar_frame, fixed_frame, match.sweep_stamp, match.image_stamp,
+                    times, input.T_cam_lidar, input.camera, cloud.cloud);
     report.motion_compensated = true;
   } catch (const tf2::TransformException& e) {
     ++counters_.motion_failures;

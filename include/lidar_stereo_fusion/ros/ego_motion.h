@@ -22,6 +22,23 @@ SweepMotion sweepMotionFromTf(const tf2::BufferCore& tf, const std::string& lida
                               const std::string& fixed_frame, const ros::Time& sweep_stamp,
                               const ros::Time& target_stamp, const std::vector<double>& times);
 
+/// The whole compensation, as the nodelet and bag_runner do it: moves `cloud` (LiDAR frame) from
+/// its points' times to `image_stamp` with sweepMotionFromTf at `times`, then drops what the camera
+/// cannot see beside near objects (removePointsHiddenBeside with `T_cam_lidar`, `camera`). Throws
+/// tf2::TransformException as sweepMotionFromTf, before the cloud is changed.
+void compensateSweep(const tf2::BufferCore& tf, const std::string& lidar_frame,
+                     const std::string& fixed_frame, const ros::Time& sweep_stamp,
+                     const ros::Time& image_stamp, const std::vector<double>& times,
+                     const Eigen::Isometry3d& T_cam_lidar, const StereoCamera& camera,
+                     LidarCloud& cloud);
+
+/// The stamp to take the LiDAR -> camera extrinsics at: the sweep's, or the image's when the sweep
+/// is moved there (`fixed_frame` set).
+inline ros::Time extrinsicsStamp(const std::string& fixed_frame, const ros::Time& sweep_stamp,
+                                 const ros::Time& image_stamp) {
+  return fixed_frame.empty() ? sweep_stamp : image_stamp;
+}
+
 /// The instants a sweep's motion is sampled at: `samples` instants evenly over the span of the
 /// cloud's point times, or the stamp alone (t = 0) when the points carry no time (the whole sweep
 /// then moves from its stamp to the image's: the time offset alone).
