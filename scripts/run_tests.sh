@@ -22,6 +22,9 @@ bash "$ROOT/scripts/install_deps.sh"
 echo "== format (clang-format 14, .clang-format)"
 format_status=0
 bash "$ROOT/scripts/check_format.sh" || format_status=$?
+echo "== docs (doc/method.md names existing files and functions)"
+docs_status=0
+bash "$ROOT/scripts/check_docs.sh" || docs_status=$?
 
 # Debian's ROS uses the system Python; a pyenv python3 first on PATH breaks catkin.
 export PATH=/usr/bin:/bin:$PATH
@@ -83,5 +86,9 @@ fi
 if [ $format_status -ne 0 ]; then
   echo "C++ sources differ from clang-format's format (see '== format' above)" >&2
   exit $format_status
+fi
+if [ $docs_status -ne 0 ]; then
+  echo "doc/method.md names a file or function that does not exist (see '== docs' above)" >&2
+  exit $docs_status
 fi
 exit $summary_status
