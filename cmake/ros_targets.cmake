@@ -14,6 +14,8 @@ add_library(${PROJECT_NAME}_ros
   src/ros/cloud_conversions.cpp
   src/ros/ego_motion.cpp
   src/ros/ros_params.cpp
+  src/ros/node_params.cpp
+  src/ros/param_files.cpp
   src/ros/node_support.cpp
   src/ros/stereo_sync.cpp
   src/ros/input_gate.cpp

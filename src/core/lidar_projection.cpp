@@ -1,6 +1,8 @@
 // Stage 1: LiDAR projection (paper Eq. 1-2) and scan-line (ring) recovery.
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 
+#include "lidar_stereo_fusion/core/param_table.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -50,15 +52,11 @@ short ringToShort(int ring) {
 }  // namespace
 
 void ProjectionParams::validate() const {
-  if (!std::isfinite(min_depth) || min_depth <= 0.0) {
-    throw std::invalid_argument("ProjectionParams: min_depth must be finite and > 0 [m], got " +
-                                std::to_string(min_depth));
-  }
-  if (!std::isfinite(max_depth) || max_depth <= min_depth) {
-    throw std::invalid_argument(
-        "ProjectionParams: max_depth must be finite and > min_depth [m], "
-        "got " +
-        std::to_string(max_depth));
+  requireRanges("ProjectionParams", *this);
+  if (max_depth <= min_depth) {
+    throw std::invalid_argument("ProjectionParams: max_depth must be > min_depth (" +
+                                formatParamDouble(min_depth) + ") m, got " +
+                                formatParamDouble(max_depth));
   }
 }
 

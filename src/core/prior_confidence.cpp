@@ -1,6 +1,8 @@
 // Stage 2, last step: the prior's confidence (readings in prior_confidence.h).
 #include "lidar_stereo_fusion/core/prior_confidence.h"
 
+#include "lidar_stereo_fusion/core/param_table.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -11,10 +13,6 @@
 namespace lidar_stereo_fusion {
 
 namespace {
-
-void require(bool ok, const std::string& message) {
-  if (!ok) throw std::invalid_argument("PriorConfidenceParams: " + message);
-}
 
 /// Slope [px/row] of the line pair (a above b), or NaN when it is steeper than max_slope (the
 /// pair is itself an edge and predicts nothing).
@@ -42,16 +40,7 @@ float intervalResidual(const ColumnEntry* e, int n, int k, float max_slope) {
 
 }  // namespace
 
-void PriorConfidenceParams::validate() const {
-  require(std::isfinite(edge_tolerance) && edge_tolerance >= 0, "edge_tolerance must be >= 0");
-  require(std::isfinite(edge_sigma) && edge_sigma > 0, "edge_sigma must be > 0");
-  require(std::isfinite(max_surface_slope) && max_surface_slope >= 0,
-          "max_surface_slope must be >= 0");
-  require(removed_factor >= 0 && removed_factor <= 1, "removed_factor must be in [0, 1]");
-  require(std::isfinite(near_rows) && near_rows >= 0, "near_rows must be >= 0");
-  require(std::isfinite(decay_rows) && decay_rows >= 0, "decay_rows must be >= 0 (0 = off)");
-  require(hole_confidence >= 0 && hole_confidence <= 1, "hole_confidence must be in [0, 1]");
-}
+void PriorConfidenceParams::validate() const { requireRanges("PriorConfidenceParams", *this); }
 
 cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
                           const std::vector<cv::Point>& removed,

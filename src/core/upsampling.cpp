@@ -6,6 +6,8 @@
 // (fresh full-size buffers cost page faults every frame).
 #include "lidar_stereo_fusion/core/upsampling.h"
 
+#include "lidar_stereo_fusion/core/param_table.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -129,9 +131,6 @@ class RangeWeightTable {
   double last_ = 0.0;
 };
 
-constexpr int kMaxRadius = 255;     ///< BF* half window limit [px]
-constexpr double kMinSigma = 1e-6;  ///< BF* smallest sigma [px] (keeps the tables finite)
-
 /// Sparse points of one row: column and disparity, ordered by column.
 struct RowPoint {
   int x;
@@ -183,50 +182,14 @@ void filterRow(const std::vector<WindowPoint>& window, const std::vector<double>
 
 }  // namespace
 
-void BIParams::validate() const {
-  if (max_gap_px < 0) {
-    throw std::invalid_argument("BIParams: max_gap_px must be >= 0 [px], got " +
-                                std::to_string(max_gap_px));
-  }
-  if (!std::isfinite(max_jump_disp) || max_jump_disp < 0.0) {
-    throw std::invalid_argument("BIParams: max_jump_disp must be finite and >= 0 [px], got " +
-                                std::to_string(max_jump_disp));
-  }
-  if (!std::isfinite(max_disp_diff) || max_disp_diff < 0.0) {
-    throw std::invalid_argument("BIParams: max_disp_diff must be finite and >= 0 [px], got " +
-                                std::to_string(max_disp_diff));
-  }
-  if (!std::isfinite(max_color_diff) || max_color_diff <= 0.0) {
-    throw std::invalid_argument("BIParams: max_color_diff must be finite and > 0 (RGB L1), got " +
-                                std::to_string(max_color_diff));
-  }
-  if (search_lines < 1) {
-    throw std::invalid_argument("BIParams: search_lines must be >= 1, got " +
-                                std::to_string(search_lines));
-  }
-  if (max_interp_rows < 1) {
-    throw std::invalid_argument("BIParams: max_interp_rows must be >= 1 [rows], got " +
-                                std::to_string(max_interp_rows));
-  }
-}
+void BIParams::validate() const { requireRanges("BIParams", *this); }
 
 void BFParams::validate() const {
-  if (radius < 0 || radius > kMaxRadius) {
-    throw std::invalid_argument("BFParams: radius must be in [0, " + std::to_string(kMaxRadius) +
-                                "] [px], got " + std::to_string(radius));
-  }
-  if (!std::isfinite(sigma_space) || sigma_space < kMinSigma) {
-    throw std::invalid_argument("BFParams: sigma_space must be finite and >= 1e-6 [px], got " +
-                                std::to_string(sigma_space));
-  }
-  if (!std::isfinite(sigma_range) || sigma_range < kMinSigma) {
-    throw std::invalid_argument("BFParams: sigma_range must be finite and >= 1e-6 [px], got " +
-                                std::to_string(sigma_range));
-  }
+  requireRanges("BFParams", *this);
   const int window = (2 * radius + 1) * (2 * radius + 1);
-  if (min_support < 1 || min_support > window) {
-    throw std::invalid_argument("BFParams: min_support must be in [1, " + std::to_string(window) +
-                                "] (window pixels), got " + std::to_string(min_support));
+  if (min_support > window) {
+    throw std::invalid_argument("BFParams: min_support must be <= " + std::to_string(window) +
+                                " (the window's pixels), got " + std::to_string(min_support));
   }
 }
 

@@ -7,9 +7,6 @@
 #include <ros/message_event.h>
 #include <tf2_msgs/TFMessage.h>
 #include <boost/bind/bind.hpp>
-#include <opencv2/core.hpp>
-
-#include "lidar_stereo_fusion/io/params_yaml.h"
 
 namespace lidar_stereo_fusion {
 
@@ -25,58 +22,6 @@ std::string seconds(double s) {
 }
 
 }  // namespace
-
-NodeParams readNodeParamsYaml(const std::string& path) {
-  NodeParams p;
-  cv::FileStorage file = openYaml(path);
-  const auto number = [&](const char* key, double& v) {
-    if (!file[key].empty()) v = static_cast<double>(file[key]);
-  };
-  const auto integer = [&](const char* key, int& v) {
-    if (!file[key].empty()) v = static_cast<int>(file[key]);
-  };
-  const cv::FileNode sync = file["approximate_sync"];
-  if (sync.isString()) {
-    // OpenCV keeps a comment after a word as part of it: the first word is the value.
-    const std::string word = sync.string().substr(0, sync.string().find_first_of(" \t#"));
-    if (word != "true" && word != "false") {
-      throw std::runtime_error(path + ": approximate_sync must be true or false, not '" + word +
-                               "'");
-    }
-    p.approximate_sync = word == "true";
-  } else if (!sync.empty()) {
-    p.approximate_sync = static_cast<int>(sync) != 0;
-  }
-  integer("queue_size", p.queue_size);
-  number("max_time_offset", p.max_time_offset);
-  number("max_sweep_wait", p.max_sweep_wait);
-  integer("sweep_buffer_size", p.sweep_buffer_size);
-  integer("num_rings", p.num_rings);
-  number("max_output_depth", p.max_output_depth);
-  integer("cloud_stride", p.cloud_stride);
-  const auto word = [&](const char* key, std::string& v) {  // the first word, as approximate_sync
-    const cv::FileNode node = file[key];
-    if (node.isString()) v = node.string().substr(0, node.string().find_first_of(" \t#"));
-  };
-  word("fixed_frame", p.fixed_frame);
-  word("motion_failure", p.motion_failure);
-  integer("motion_samples", p.motion_samples);
-  number("max_point_time", p.max_point_time);
-  if (p.motion_failure != "uncompensated" && p.motion_failure != "skip") {
-    throw std::runtime_error(path + ": motion_failure must be uncompensated or skip, not '" +
-                             p.motion_failure + "'");
-  }
-  if (p.motion_samples < 1 || p.motion_samples > 100 || !(p.max_point_time > 0.0)) {
-    throw std::runtime_error(path + ": motion_samples must be in [1, 100], max_point_time > 0");
-  }
-  if (p.queue_size < 1 || p.sweep_buffer_size < 1 || p.max_time_offset < 0 ||
-      p.max_sweep_wait < 0 || p.cloud_stride < 1 || p.num_rings < 1) {
-    throw std::runtime_error(path +
-                             ": queue_size, sweep_buffer_size, cloud_stride, num_rings must be "
-                             ">= 1 and max_time_offset, max_sweep_wait >= 0");
-  }
-  return p;
-}
 
 std::string stampName(const ros::Time& t) {
   char text[32];

@@ -44,10 +44,10 @@ Options:
   --bag FILE          input bag (repeat for a recording split into several bags)
   --out DIR           output folder (created)
   --params YAML       algorithm parameters (config/fusion.yaml layout; default: the built-in ones)
-  --node-params YAML  synchronisation parameters (config/fusion_node.yaml layout: approximate_sync,
-                      queue_size, max_time_offset, max_sweep_wait, sweep_buffer_size, num_rings,
-                      max_output_depth, cloud_stride; fixed_frame, motion_samples, motion_failure,
-                      max_point_time: ego-motion compensation from the bag's /tf, doc/motion.md)
+  --node-params YAML  node parameters (config/fusion_node.yaml layout, checked as the node checks
+                      them; used here: the synchronisation, num_rings, max_output_depth,
+                      cloud_stride and the ego-motion compensation from the bag's /tf with
+                      fixed_frame, motion_samples, motion_failure, max_point_time; doc/motion.md)
   --approximate-sync  ApproximateTime image sync (as approximate_sync: true)
   --method NAME       fused_bi | fused_bf | pms | lidar_bi | lidar_bf (overrides --params)
   --start S, --end S  only the image sets whose left image was recorded in [S, E) seconds after

@@ -24,6 +24,14 @@ namespace lidar_stereo_fusion {
 
 namespace {
 
+/// The node parameters under `pnh`, each problem logged as an error naming the parameter.
+NodeParams readNodeParamsLogged(const ros::NodeHandle& pnh, const std::string& name) {
+  std::vector<std::string> errors;
+  NodeParams p = ros_params::readNodeParams(pnh, &errors);
+  for (const auto& e : errors) ROS_ERROR_STREAM("[" << name << "] " << e);
+  return p;
+}
+
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -36,7 +44,7 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
     : nh_(nh),
       pnh_(pnh),
       name_(name),
-      node_params_(NodeParams::read(pnh)),
+      node_params_(readNodeParamsLogged(pnh, name)),
       log_(name, node_params_.log_throttle_period),
       gate_(nh, pnh, node_params_, counters_, log_),
       outputs_(nh, pnh, name, node_params_, counters_, gate_),
@@ -53,6 +61,7 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
     params = FusionParams();
   }
   params_ = params;
+  live_node_ = frame_node_ = node_params_;
   std::string simd_warning;  // the SIMD path is no parameter: LSF_SIMD, kept by reconfigure
   params_.patchmatch.simd_path = simdPathFromEnvironment(&simd_warning);
   if (!simd_warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << simd_warning);
@@ -61,7 +70,7 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
   // Live parameters: start from the values just read, then follow dynamic_reconfigure.
   reconfigure_server_ =
       std::make_unique<dynamic_reconfigure::Server<FusionConfig>>(reconfigure_mutex_, pnh_);
-  reconfigure_server_->updateConfig(ros_params::toConfig(params_));
+  reconfigure_server_->updateConfig(ros_params::toConfig(params_, live_node_));
   reconfigure_server_->setCallback(boost::bind(&FusionWorker::reconfigureCb, this,
                                                boost::placeholders::_1, boost::placeholders::_2));
 
@@ -88,28 +97,35 @@ FusionWorker::~FusionWorker() {
 
 void FusionWorker::reconfigureCb(FusionConfig& config, uint32_t /*level*/) {
   FusionParams current;
+  NodeParams current_node;
   {
     std::lock_guard<std::mutex> lock(params_mutex_);
     current = params_;
+    current_node = live_node_;
   }
   FusionParams candidate;
+  NodeParams candidate_node = current_node;
   try {
-    candidate = ros_params::fromConfig(config);
+    candidate = ros_params::fromConfig(config, &candidate_node);
     candidate.patchmatch.simd_path = current.patchmatch.simd_path;
     candidate.validate();
+    candidate_node.validate();
   } catch (const std::exception& e) {
     // Refused as a whole: the response (and `dynparam get`) carry the values in force.
-    const std::string asked = ros_params::describeRequest(current, config);
-    config = ros_params::toConfig(current);
+    const std::string asked = ros_params::describeRequest(current, current_node, config);
+    config = ros_params::toConfig(current, current_node);
     ROS_ERROR_STREAM("[" << name_ << "] parameter change refused: " << e.what() << "; asked "
                          << asked << "; every parameter keeps the value in force");
     return;
   }
-  const std::string changes = ros_params::describeChanges(current, candidate);
+  std::string changes = ros_params::describeChanges(current, candidate);
+  const std::string node_changes = ros_params::describeChanges(current_node, candidate_node);
+  if (!node_changes.empty()) changes += (changes.empty() ? "" : ", ") + node_changes;
   if (changes.empty()) return;
   {
     std::lock_guard<std::mutex> lock(params_mutex_);
     params_ = candidate;
+    live_node_ = candidate_node;
     params_changed_ = true;
   }
   ros_params::writeParams(pnh_, candidate);
@@ -143,6 +159,8 @@ void FusionWorker::workerLoop() {
       std::lock_guard<std::mutex> lock(params_mutex_);
       if (params_changed_) {
         pipeline.setParams(params_);  // validated in reconfigureCb
+        frame_node_ = live_node_;
+        outputs_.setLiveParams(frame_node_);
         params_changed_ = false;
       }
     }
@@ -166,20 +184,20 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   // Extrinsics at the sweep stamp, or at the image stamp the points are moved to with
   // ~fixed_frame; a short timeout bounds the wait (worker thread only).
   const ros::Time extrinsics_stamp =
-      extrinsicsStamp(node_params_.fixed_frame, match.sweep_stamp, match.image_stamp);
+      extrinsicsStamp(frame_node_.fixed_frame, match.sweep_stamp, match.image_stamp);
   FusionInput input;
   try {
     const geometry_msgs::TransformStamped tf = tf_buffer_.lookupTransform(
-        camera_frame, lidar_frame, extrinsics_stamp, ros::Duration(node_params_.tf_timeout));
+        camera_frame, lidar_frame, extrinsics_stamp, ros::Duration(frame_node_.tf_timeout));
     input.T_cam_lidar = tf2::transformToEigen(tf);
   } catch (const tf2::TransformException& e) {
     ++counters_.tf_failures;
     log_.warn(kCloud, "tf",
               "no transform from '" + lidar_frame + "' (" + topicName(kCloud) + ") to '" +
                   camera_frame + "' (" + topicName(kLeftImage) + ") at " +
-                  (node_params_.fixed_frame.empty() ? "sweep stamp " : "image stamp ") +
+                  (frame_node_.fixed_frame.empty() ? "sweep stamp " : "image stamp ") +
                   stampText(extrinsics_stamp) + " within " +
-                  std::to_string(node_params_.tf_timeout) + " s: " + e.what() + "; frame skipped");
+                  std::to_string(frame_node_.tf_timeout) + " s: " + e.what() + "; frame skipped");
     return;
   }
 
@@ -189,7 +207,7 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   try {
     conversions::stereoPairToCore(set.left, set.right, input.left, input.right, &pair_note);
     input.camera = conversions::stereoCameraFromInfo(*set.left_info, *set.right_info);
-    cloud = conversions::cloudFromMsg(cloud_msg, node_params_.max_point_time);
+    cloud = conversions::cloudFromMsg(cloud_msg, frame_node_.max_point_time);
   } catch (const std::exception& e) {  // ConversionError, and anything OpenCV lets through
     ++counters_.invalid;
     log_.warn("input set", "convert",
@@ -214,7 +232,7 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   }
   FrameReport report;
   // The ring field if plausible, else the offline sweep-order rule, else elevation; each checked.
-  report.rings = ensureRings(cloud.cloud, cloud.has_ring, node_params_.num_rings);
+  report.rings = ensureRings(cloud.cloud, cloud.has_ring, frame_node_.num_rings);
   if (!report.rings.plausible) {
     log_.warn(kCloud, "rings",
               topicName(kCloud) + ": no plausible scan lines in the sweep at " +
@@ -232,11 +250,11 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
                   std::to_string(cloud.cloud.size()) + " points of the sweep at " +
                   stampText(match.sweep_stamp) + " have a '" + report.point_time_field +
                   "' time that is NaN or more than ~max_point_time = " +
-                  std::to_string(node_params_.max_point_time) + " s from the stamp (e.g. " +
+                  std::to_string(frame_node_.max_point_time) + " s from the stamp (e.g. " +
                   std::to_string(cloud.bad_time_example) +
                   " s): their time is not used (wrong unit or clock?)");
   }
-  if (!node_params_.fixed_frame.empty() && !compensateEgoMotion(match, input, cloud, report)) {
+  if (!frame_node_.fixed_frame.empty() && !compensateEgoMotion(match, input, cloud, report)) {
     return;
   }
   input.cloud = std::move(cloud.cloud);
@@ -264,26 +282,26 @@ bool FusionWorker::compensateEgoMotion(const InputMatch& match, const FusionInpu
                                        conversions::CloudConversion& cloud, FrameReport& report) {
   const auto start = std::chrono::steady_clock::now();
   const std::string& lidar_frame = match.sweep->header.frame_id;
-  const std::string& fixed_frame = node_params_.fixed_frame;
+  const std::string& fixed_frame = frame_node_.fixed_frame;
   const std::vector<double> times =
-      motionSampleTimes(cloud.cloud, cloud.has_time, node_params_.motion_samples);
+      motionSampleTimes(cloud.cloud, cloud.has_time, frame_node_.motion_samples);
   try {
     // One bounded wait for the latest instant needed; the samples are then looked up at once.
     const ros::Time latest =
         std::max(match.image_stamp, match.sweep_stamp + ros::Duration(times.back()));
     std::string why;
     if (!tf_buffer_.canTransform(fixed_frame, lidar_frame, latest,
-                                 ros::Duration(node_params_.tf_timeout), &why)) {
+                                 ros::Duration(frame_node_.tf_timeout), &why)) {
       throw tf2::TransformException("no transform from '" + lidar_frame + "' to '" + fixed_frame +
                                     "' at " + stampText(latest) + " within " +
-                                    std::to_string(node_params_.tf_timeout) + " s: " + why);
+                                    std::to_string(frame_node_.tf_timeout) + " s: " + why);
     }
     compensateSweep(tf_buffer_, lidar_frame, fixed_frame, match.sweep_stamp, match.image_stamp,
                     times, input.T_cam_lidar, input.camera, cloud.cloud);
     report.motion_compensated = true;
   } catch (const tf2::TransformException& e) {
     ++counters_.motion_failures;
-    const bool skip = node_params_.motion_failure == "skip";
+    const bool skip = frame_node_.motion_failure == "skip";
     log_.warn(kCloud, "egomotion",
               std::string("ego-motion compensation of the sweep at ") +
                   stampText(match.sweep_stamp) + " to the images at " +

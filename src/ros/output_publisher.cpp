@@ -152,6 +152,12 @@ void OutputPublisher::connectCb() {
   }
 }
 
+void OutputPublisher::setLiveParams(const NodeParams& params) {
+  params_.cloud_stride = params.cloud_stride;
+  params_.max_output_depth = params.max_output_depth;
+  params_.depth_color_max = params.depth_color_max;
+}
+
 void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camera,
                               const cv::Mat& left_image, const FusionResult& result,
                               const FusionParams& params, const FrameReport& report) {

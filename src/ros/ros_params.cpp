@@ -18,11 +18,9 @@ namespace ros_params {
 
 namespace {
 
-constexpr int kMaxThreads = 256;  ///< as PatchMatchParams::validate()
-
 /// The deprecated spellings of a parameter: ~group/field (the grouped YAML loaded by rosparam) and
 /// group_field (the former dynamic_reconfigure name).
-std::vector<std::string> deprecatedNames(const ParamName& n) {
+std::vector<std::string> deprecatedNames(const ParamSpec& n) {
   if (*n.group == '\0') return {};
   return {std::string(n.group) + "/" + n.name, std::string(n.group) + "_" + n.name};
 }
@@ -31,11 +29,13 @@ std::vector<std::string> deprecatedNames(const ParamName& n) {
 struct Reader {
   const ros::NodeHandle& nh;
   std::vector<std::string>& errors;
+  bool aliases = true;  ///< the algorithm's deprecated grouped names (the node's have none)
 
   /// The value under the name, or else under a deprecated name (said, and deleted so that the
   /// parameter server holds one spelling).
-  bool fetch(const ParamName& n, XmlRpc::XmlRpcValue& value) const {
+  bool fetch(const ParamSpec& n, XmlRpc::XmlRpcValue& value) const {
     bool found = nh.hasParam(n.name) && nh.getParam(n.name, value);
+    if (!aliases) return found;
     for (const std::string& old : deprecatedNames(n)) {
       XmlRpc::XmlRpcValue old_value;
       if (!nh.hasParam(old) || !nh.getParam(old, old_value)) continue;
@@ -52,33 +52,49 @@ struct Reader {
     }
     return found;
   }
-  void wrongType(const ParamName& n, const char* expected, XmlRpc::XmlRpcValue& value) {
+  void wrongType(const ParamSpec& n, const char* expected, XmlRpc::XmlRpcValue& value) {
     std::ostringstream s;
     s << "parameter " << nh.resolveName(n.name) << ": expected " << expected << ", got '"
       << value.toXml() << "'; keeping the previous value";
     errors.push_back(s.str());
   }
-  void operator()(const ParamName& n, double& out) {
+  /// Takes `candidate` unless the row's range or choices refuse it (then says so, naming it).
+  template <class T>
+  void take(const ParamSpec& n, const T& candidate, T& out) {
+    std::string problem;
+    if constexpr (std::is_same_v<T, std::string>) {
+      problem = choiceProblem(n, candidate);
+    } else {
+      problem = rangeProblem(n, static_cast<double>(candidate));
+    }
+    if (problem.empty()) {
+      out = candidate;
+    } else {
+      errors.push_back("parameter " + nh.resolveName(n.name) + ": " + problem +
+                       "; keeping the previous value");
+    }
+  }
+  void operator()(const ParamSpec& n, double& out) {
     XmlRpc::XmlRpcValue v;
     if (!fetch(n, v)) return;
     if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
-      out = static_cast<double>(v);
+      take(n, static_cast<double>(v), out);
     } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
-      out = static_cast<int>(v);
+      take(n, static_cast<double>(static_cast<int>(v)), out);
     } else {
       wrongType(n, "a number", v);
     }
   }
-  void operator()(const ParamName& n, int& out) {
+  void operator()(const ParamSpec& n, int& out) {
     XmlRpc::XmlRpcValue v;
     if (!fetch(n, v)) return;
     if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
-      out = static_cast<int>(v);
+      take(n, static_cast<int>(v), out);
     } else {
       wrongType(n, "an integer", v);
     }
   }
-  void operator()(const ParamName& n, bool& out) {
+  void operator()(const ParamSpec& n, bool& out) {
     XmlRpc::XmlRpcValue v;
     if (!fetch(n, v)) return;
     if (v.getType() == XmlRpc::XmlRpcValue::TypeBoolean) {
@@ -87,7 +103,16 @@ struct Reader {
       wrongType(n, "true or false", v);
     }
   }
-  void operator()(const ParamName& n, Method& out) {
+  void operator()(const ParamSpec& n, std::string& out) {
+    XmlRpc::XmlRpcValue v;
+    if (!fetch(n, v)) return;
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeString) {
+      take(n, static_cast<std::string>(v), out);
+    } else {
+      wrongType(n, "text", v);
+    }
+  }
+  void operator()(const ParamSpec& n, Method& out) {
     XmlRpc::XmlRpcValue v;
     if (!fetch(n, v)) return;
     if (v.getType() != XmlRpc::XmlRpcValue::TypeString) {
@@ -101,7 +126,7 @@ struct Reader {
                        "; keeping the previous value");
     }
   }
-  void operator()(const ParamName& n, uint64_t& out) {
+  void operator()(const ParamSpec& n, uint64_t& out) {
     XmlRpc::XmlRpcValue v;
     if (!fetch(n, v)) return;
     if (v.getType() == XmlRpc::XmlRpcValue::TypeInt && static_cast<int>(v) >= 0) {
@@ -115,14 +140,24 @@ struct Reader {
 // Writing to the parameter server -------------------------------------------------------------
 struct Writer {
   const ros::NodeHandle& nh;
-  void operator()(const ParamName& n, const double& v) { nh.setParam(n.name, v); }
-  void operator()(const ParamName& n, const int& v) { nh.setParam(n.name, v); }
-  void operator()(const ParamName& n, const bool& v) { nh.setParam(n.name, v); }
-  void operator()(const ParamName& n, const Method& v) { nh.setParam(n.name, methodName(v)); }
-  void operator()(const ParamName& n, const uint64_t& v) {
+  void operator()(const ParamSpec& n, const double& v) { nh.setParam(n.name, v); }
+  void operator()(const ParamSpec& n, const int& v) { nh.setParam(n.name, v); }
+  void operator()(const ParamSpec& n, const bool& v) { nh.setParam(n.name, v); }
+  void operator()(const ParamSpec& n, const std::string& v) { nh.setParam(n.name, v); }
+  void operator()(const ParamSpec& n, const Method& v) { nh.setParam(n.name, methodName(v)); }
+  void operator()(const ParamSpec& n, const uint64_t& v) {
     nh.setParam(n.name, static_cast<int>(v));
   }
 };
+
+/// Visits the rows dynamic_reconfigure carries: every algorithm row, the node's live ones.
+template <class P, class V>
+void visitLive(P& p, V&& v) {
+  visitParamTable(p.fusion, v);
+  visitParams(p.node, [&v](const ParamSpec& spec, auto& field) {
+    if (spec.live == Live::kYes) v(spec, field);
+  });
+}
 
 // dynamic_reconfigure messages ----------------------------------------------------------------
 template <class Entry>
@@ -134,34 +169,38 @@ Entry* findEntry(std::vector<Entry>& entries, const std::string& name) {
                          "' (cfg and ros_params.cpp are out of sync)");
 }
 
-/// Writes FusionParams into a dynamic_reconfigure::Config message.
+/// Writes the live rows into a dynamic_reconfigure::Config message.
 struct ToMessage {
   dynamic_reconfigure::Config& msg;
-  void operator()(const ParamName& n, const double& v) {
+  void operator()(const ParamSpec& n, const double& v) {
     findEntry(msg.doubles, n.name)->value = v;
   }
-  void operator()(const ParamName& n, const int& v) { findEntry(msg.ints, n.name)->value = v; }
-  void operator()(const ParamName& n, const bool& v) { findEntry(msg.bools, n.name)->value = v; }
-  void operator()(const ParamName& n, const Method& v) {
+  void operator()(const ParamSpec& n, const int& v) { findEntry(msg.ints, n.name)->value = v; }
+  void operator()(const ParamSpec& n, const bool& v) { findEntry(msg.bools, n.name)->value = v; }
+  void operator()(const ParamSpec& n, const Method& v) {
     findEntry(msg.strs, n.name)->value = methodName(v);
   }
-  void operator()(const ParamName& n, const uint64_t& v) {
+  void operator()(const ParamSpec& n, const std::string& v) {
+    findEntry(msg.strs, n.name)->value = v;
+  }
+  void operator()(const ParamSpec& n, const uint64_t& v) {
     const uint64_t max = static_cast<uint64_t>(std::numeric_limits<int>::max());
     findEntry(msg.ints, n.name)->value = static_cast<int>(v > max ? max : v);
   }
 };
 
-/// Reads FusionParams from a dynamic_reconfigure::Config message; throws std::invalid_argument
+/// Reads the live rows from a dynamic_reconfigure::Config message; throws std::invalid_argument
 /// naming the parameter for values no field can hold.
 struct FromMessage {
   dynamic_reconfigure::Config& msg;
-  void operator()(const ParamName& n, double& v) {
+  void operator()(const ParamSpec& n, double& v) {
     v = findEntry(msg.doubles, n.name)->value;
     if (!std::isfinite(v)) throw std::invalid_argument(std::string(n.name) + " must be finite");
   }
-  void operator()(const ParamName& n, int& v) { v = findEntry(msg.ints, n.name)->value; }
-  void operator()(const ParamName& n, bool& v) { v = findEntry(msg.bools, n.name)->value; }
-  void operator()(const ParamName& n, Method& v) {
+  void operator()(const ParamSpec& n, int& v) { v = findEntry(msg.ints, n.name)->value; }
+  void operator()(const ParamSpec& n, bool& v) { v = findEntry(msg.bools, n.name)->value; }
+  void operator()(const ParamSpec& n, std::string& v) { v = findEntry(msg.strs, n.name)->value; }
+  void operator()(const ParamSpec& n, Method& v) {
     const std::string& name = findEntry(msg.strs, n.name)->value;
     try {
       v = parseMethod(name);
@@ -169,7 +208,7 @@ struct FromMessage {
       throw std::invalid_argument(std::string(n.name) + ": " + e.what());
     }
   }
-  void operator()(const ParamName& n, uint64_t& v) {
+  void operator()(const ParamSpec& n, uint64_t& v) {
     const int value = findEntry(msg.ints, n.name)->value;
     if (value < 0) {
       throw std::invalid_argument(std::string(n.name) + " must be >= 0, got " +
@@ -194,20 +233,44 @@ std::vector<std::pair<std::string, std::string>> messageEntries(
 struct Stringifier {
   std::vector<std::pair<std::string, std::string>> out;
   template <class T>
-  void operator()(const ParamName& n, const T& v) {
+  void operator()(const ParamSpec& n, const T& v) {
     std::ostringstream s;
     s << std::boolalpha << v;
     out.emplace_back(n.name, s.str());
   }
-  void operator()(const ParamName& n, const double& v) {
+  void operator()(const ParamSpec& n, const double& v) {
     out.emplace_back(n.name, formatParamDouble(v));
   }
-  void operator()(const ParamName& n, const Method& v) { out.emplace_back(n.name, methodName(v)); }
+  void operator()(const ParamSpec& n, const Method& v) { out.emplace_back(n.name, methodName(v)); }
+};
+
+/// "name: old -> new" for each entry that differs (the same table on both sides).
+std::string differences(const Stringifier& a, const Stringifier& b) {
+  std::string out;
+  for (size_t i = 0; i < a.out.size(); ++i) {
+    if (a.out[i].second == b.out[i].second) continue;
+    if (!out.empty()) out += ", ";
+    out += a.out[i].first + ": " + a.out[i].second + " -> " + b.out[i].second;
+  }
+  return out;
+}
+
+/// What dynamic_reconfigure carries: the algorithm's rows and the node's live ones.
+struct LiveSet {
+  FusionParams fusion;
+  NodeParams node;
 };
 
 }  // namespace
 
 std::vector<ParamInfo> listParams() { return paramTable(); }
+
+std::vector<ParamInfo> listNodeParams() {
+  std::vector<ParamInfo> out;
+  const NodeParams defaults;
+  visitParams(defaults, ParamLister{out});
+  return out;
+}
 
 FusionParams readParams(const ros::NodeHandle& pnh, const FusionParams& base,
                         std::vector<std::string>* errors) {
@@ -215,16 +278,6 @@ FusionParams readParams(const ros::NodeHandle& pnh, const FusionParams& base,
   std::vector<std::string>& errs = errors ? *errors : local;
   FusionParams p = base;
   visitParamTable(p, Reader{pnh, errs});
-  // rosparam bypasses validate() until the whole set is checked; a thread count beyond this
-  // crashes libgomp, so it is refused on its own.
-  if (p.patchmatch.num_threads < 0 || p.patchmatch.num_threads > kMaxThreads) {
-    errs.push_back("parameter " + pnh.resolveName("num_threads") + " = " +
-                   std::to_string(p.patchmatch.num_threads) + " is out of range [0, " +
-                   std::to_string(kMaxThreads) + "] (0 = all cores); keeping " +
-                   std::to_string(base.patchmatch.num_threads));
-    p.patchmatch.num_threads = base.patchmatch.num_threads;
-  }
-
   // Keys left under the old groups are typos (the known ones were read and deleted above).
   std::vector<std::string> names;
   if (ros::param::getParamNames(names)) {
@@ -241,43 +294,61 @@ FusionParams readParams(const ros::NodeHandle& pnh, const FusionParams& base,
   return p;
 }
 
+NodeParams readNodeParams(const ros::NodeHandle& pnh, std::vector<std::string>* errors) {
+  std::vector<std::string> local;
+  std::vector<std::string>& errs = errors ? *errors : local;
+  NodeParams p;
+  visitParams(p, Reader{pnh, errs, /*aliases=*/false});
+  try {
+    p.validate();  // the checks between rows; each row's range was checked as it was read
+  } catch (const std::exception& e) {
+    errs.push_back(std::string(e.what()) + "; using the defaults of every node parameter");
+    p = NodeParams();
+  }
+  return p;
+}
+
 void writeParams(const ros::NodeHandle& pnh, const FusionParams& params) {
   visitParamTable(params, Writer{pnh});
 }
 
-FusionConfig toConfig(const FusionParams& params) {
+FusionConfig toConfig(const FusionParams& params, const NodeParams& node) {
   FusionConfig config = FusionConfig::__getDefault__();
   dynamic_reconfigure::Config msg;
   config.__toMessage__(msg);
-  visitParamTable(params, ToMessage{msg});
+  const LiveSet set{params, node};
+  visitLive(set, ToMessage{msg});
   config.__fromMessage__(msg);
   return config;
 }
 
-FusionParams fromConfig(const FusionConfig& config) {
+FusionParams fromConfig(const FusionConfig& config, NodeParams* node) {
   dynamic_reconfigure::Config msg;
   config.__toMessage__(msg);
-  FusionParams p;
-  visitParamTable(p, FromMessage{msg});
-  return p;
+  LiveSet set{FusionParams(), node ? *node : NodeParams()};
+  visitLive(set, FromMessage{msg});
+  if (node) *node = set.node;
+  return set.fusion;
 }
 
 std::string describeChanges(const FusionParams& from, const FusionParams& to) {
   Stringifier sa, sb;
   visitParamTable(from, sa);
   visitParamTable(to, sb);
-  std::string out;
-  for (size_t i = 0; i < sa.out.size(); ++i) {
-    if (sa.out[i].second == sb.out[i].second) continue;
-    if (!out.empty()) out += ", ";
-    out += sa.out[i].first + ": " + sa.out[i].second + " -> " + sb.out[i].second;
-  }
-  return out;
+  return differences(sa, sb);
 }
 
-std::string describeRequest(const FusionParams& current, const FusionConfig& requested) {
+std::string describeChanges(const NodeParams& from, const NodeParams& to) {
+  Stringifier sa, sb;
+  visitParams(from, sa);
+  visitParams(to, sb);
+  return differences(sa, sb);
+}
+
+std::string describeRequest(const FusionParams& current, const NodeParams& node,
+                            const FusionConfig& requested) {
   dynamic_reconfigure::Config now, asked;
-  toConfig(current).__toMessage__(now);
+  toConfig(current, node).__toMessage__(now);
   requested.__toMessage__(asked);
   const auto a = messageEntries(now), b = messageEntries(asked);
   std::string out;

@@ -211,7 +211,7 @@ TEST(ParamsYaml, PartialRosparamStyleFileOverridesOnlyWhatItNames) {
   expectSame(p, expected);
 }
 
-// One name per parameter (issue 10): the keys are the names of io/param_table.h at the top level,
+// One name per parameter (issue 10): the keys are the names of core/param_table.h at the top level,
 // as rosparam and dynamic_reconfigure spell them; the former sections are still read.
 TEST(ParamsYaml, TopLevelNamesAndTheDeprecatedSectionsGiveTheSameParameters) {
   YamlFile flat("method: pms\nmax_depth: 120\nwindow_radius: 7\nslanted: false\nseed: 7\n");

@@ -583,6 +583,83 @@ TEST_F(FusionNode, ParametersChangeLiveAndInvalidOnesAreRejected) {
   EXPECT_EQ(stats->method, "fused_bi");
 }
 
+/// Finite depth values [m] of a depth image.
+std::vector<float> finiteDepths(const sensor_msgs::Image& depth) {
+  std::vector<float> out;
+  for (uint32_t r = 0; r < depth.height; ++r) {
+    const float* row = reinterpret_cast<const float*>(&depth.data[r * depth.step]);
+    for (uint32_t c = 0; c < depth.width; ++c) {
+      if (std::isfinite(row[c])) out.push_back(row[c]);
+    }
+  }
+  return out;
+}
+
+// Issue 24: the node's live parameters (ros/node_params.h rows marked live) change through
+// dynamic_reconfigure from the next frame; a value outside its row's range is refused with the
+// table's sentence, as the algorithm's are.
+TEST_F(FusionNode, NodeParametersChangeLiveWithinTheirTableRanges) {
+  const std::string service = h().fusionNode() + "/set_parameters";
+  ASSERT_TRUE(ros::service::waitForService(service, 5000));
+  auto set = [&](dynamic_reconfigure::Config request, dynamic_reconfigure::Config* result) {
+    dynamic_reconfigure::Reconfigure srv;
+    srv.request.config = request;
+    const bool ok = ros::service::call(service, srv);
+    if (result) *result = srv.response.config;
+    return ok;
+  };
+  auto one = [](const std::string& name, auto value) {
+    dynamic_reconfigure::Config c;
+    if constexpr (std::is_same_v<decltype(value), int>) {
+      dynamic_reconfigure::IntParameter p;
+      p.name = name;
+      p.value = value;
+      c.ints.push_back(p);
+    } else {
+      dynamic_reconfigure::DoubleParameter p;
+      p.name = name;
+      p.value = value;
+      c.doubles.push_back(p);
+    }
+    return c;
+  };
+
+  // Out of range: refused, in the words of the table; the response carries the value in force.
+  std::size_t mark = h().logMark();
+  dynamic_reconfigure::Config result;
+  ASSERT_TRUE(set(one("cloud_stride", 0), &result));
+  int stride = -1;
+  for (const auto& p : result.ints) {
+    if (p.name == "cloud_stride") stride = p.value;
+  }
+  EXPECT_EQ(stride, 1);
+  EXPECT_TRUE(h().waitForLog(mark, {"refused", "cloud_stride must be in [1, 64], got 0"}))
+      << h().logsSince(mark);
+
+  // max_output_depth applies from the next frame: nothing beyond it, less depth than before.
+  auto before = goodSetStats() ? h().image("depth/image_rect") : nullptr;
+  ASSERT_TRUE(before);
+  std::vector<float> depths = finiteDepths(*before);
+  ASSERT_GT(depths.size(), 100u);
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  const double limit = depths[depths.size() / 2];
+  mark = h().logMark();
+  ASSERT_TRUE(set(one("max_output_depth", limit), nullptr));
+  EXPECT_TRUE(h().waitForLog(mark, {"parameters changed", "max_output_depth: 0.0 -> "}))
+      << h().logsSince(mark);
+  auto after = goodSetStats() ? h().image("depth/image_rect") : nullptr;
+  ASSERT_TRUE(after);
+  const std::vector<float> limited = finiteDepths(*after);
+  EXPECT_GT(limited.size(), 0u);
+  EXPECT_LT(limited.size(), finiteDepths(*before).size());
+  EXPECT_LE(*std::max_element(limited.begin(), limited.end()), limit);
+
+  ASSERT_TRUE(set(one("max_output_depth", 0.0), nullptr));
+  auto restored = goodSetStats() ? h().image("depth/image_rect") : nullptr;
+  ASSERT_TRUE(restored);
+  EXPECT_GT(finiteDepths(*restored).size(), limited.size());
+}
+
 TEST_F(FusionNode, DiagnosticsReportRateAndProcessingTime) {
   ros::NodeHandle nh;
   std::mutex m;

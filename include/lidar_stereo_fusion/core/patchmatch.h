@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
 #include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/upsampling.h"
 
@@ -20,6 +21,15 @@ class PlaneSearch;
 }  // namespace patchmatch
 
 struct PatchMatchParams {
+  // Named limits of the ranges in core/param_table.h (kernels size their buffers by them).
+  static constexpr int kMaxWindowRadius = 50;  ///< [px] window_radius
+  static constexpr int kMaxMedianRadius = 50;  ///< [px] median_radius
+  static constexpr int kMaxIterations = 100;   ///< iterations, right_iterations, fine_iterations
+  static constexpr int kMaxCoarseScale = 16;   ///< coarse_scale
+  static constexpr int kMaxCoarseLevels = 4;   ///< coarse_levels
+  static constexpr int kMaxThreads = 256;      ///< num_threads (more crashes libgomp)
+  static constexpr double kMaxImageSmoothing = 5.0;  ///< [px] image_smoothing
+
   /// Support window (2r+1)^2 [px]. The paper found size ~10 best for its fused cost, ~40 for plain
   /// PMS; with confidence weighting the images lead where the LiDAR is absent, and need plain
   /// stereo's support there: 17x17 (sampled every 2nd pixel: 9x9 points) won on every protocol.
@@ -155,6 +165,9 @@ struct PatchMatchParams {
   SimdPath simd_path = widestSimdPath();
   void validate() const;
 };
+// The SIMD kernels size their stack buffers by cost_kernel.h's limit.
+static_assert(PatchMatchParams::kMaxWindowRadius == patchmatch::kMaxWindowRadius,
+              "window_radius's range and the kernels' buffers must agree");
 
 /// Output of PatchMatch for the left view.
 struct PatchMatchResult {

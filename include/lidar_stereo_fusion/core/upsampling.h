@@ -23,8 +23,10 @@ struct BIParams {
 };
 
 struct BFParams {
-  int radius = 6;            ///< half window [px]
-  double sigma_space = 4.0;  ///< spatial Gaussian sigma [px]
+  static constexpr int kMaxRadius = 255;     ///< [px] largest radius (core/param_table.h)
+  static constexpr double kMinSigma = 1e-6;  ///< [px] smallest sigma (keeps the tables finite)
+  int radius = 6;                            ///< half window [px]
+  double sigma_space = 4.0;                  ///< spatial Gaussian sigma [px]
   double sigma_range = 2.0;  ///< disparity-range Gaussian sigma [px] (against the nearest point)
   int min_support = 1;       ///< pixels with fewer LiDAR neighbours stay empty
   void validate() const;

@@ -84,12 +84,6 @@ class BagPairing {
   std::string refused_sweep_problem_;
 };
 
-/// The node parameters bag_runner uses (approximate_sync, queue_size, max_time_offset,
-/// max_sweep_wait, sweep_buffer_size, num_rings, max_output_depth, cloud_stride) from a file in
-/// the layout of config/fusion_node.yaml; the others keep their defaults. Throws naming the file
-/// and the problem.
-NodeParams readNodeParamsYaml(const std::string& path);
-
 /// "sec.nsec" with 9 digits of nanoseconds: the file name stem of a set's outputs.
 std::string stampName(const ros::Time& t);
 

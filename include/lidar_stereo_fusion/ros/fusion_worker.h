@@ -56,7 +56,8 @@ class FusionWorker {
 
   ros::NodeHandle nh_, pnh_;
   std::string name_;
-  NodeParams node_params_;
+  NodeParams node_params_;  ///< as read at start-up (the synchroniser, threads and log use them)
+  NodeParams frame_node_;   ///< in force for the frame being processed (worker thread only)
   ThrottledLog log_;
   Counters counters_;
   InputGate gate_;
@@ -71,6 +72,7 @@ class FusionWorker {
   // the dynamic_reconfigure server needs its own (recursive, so updateConfig() cannot deadlock).
   std::mutex params_mutex_;
   FusionParams params_;
+  NodeParams live_node_;  ///< node_params_ with the live rows dynamic_reconfigure changed
   bool params_changed_ = false;
   boost::recursive_mutex reconfigure_mutex_;
   std::unique_ptr<dynamic_reconfigure::Server<FusionConfig>> reconfigure_server_;

@@ -79,6 +79,9 @@ class OutputPublisher {
   void advertise();
   /// Unsubscribes the gate for good (shutdown).
   void shutdown();
+  /// Takes the live output parameters (cloud_stride, max_output_depth, depth_color_max) from
+  /// `params`; call from the thread that publishes, between frames.
+  void setLiveParams(const NodeParams& params);
   /// Publishes the outputs of one frame to the outputs that have subscribers.
   void publish(const InputMatch& match, const StereoCamera& camera, const cv::Mat& left_image,
                const FusionResult& result, const FusionParams& params, const FrameReport& report);

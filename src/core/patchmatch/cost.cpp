@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "lidar_stereo_fusion/core/patchmatch/simd.h"
 
@@ -62,6 +63,9 @@ MatchingCost::MatchingCost(const PatchMatchParams& params, const ViewState& self
     : p_(params), self_(self), other_(other) {
   offsets_ = windowOffsets(params.window_radius, params.window_stride, params.window_dyadic);
   rows_ = windowRows(offsets_, params.window_radius, params.window_round);
+  if (offsets_.size() > static_cast<size_t>(kMaxWindowOffsets)) {  // validate() keeps it out
+    throw std::invalid_argument("MatchingCost: window_radius beyond PatchMatchParams's limit");
+  }
   tabulateSupportWeight();
   readCostWeights();
   avx2_ = params.simd_path != SimdPath::kBaseline;

@@ -25,7 +25,8 @@ const bool kAvx2KernelBuilt = true;
 
 namespace {
 
-constexpr int kMaxOffsets = 101;  // window_radius <= 50 (PatchMatchParams::validate)
+/// Offsets per window axis at most: every pixel of the largest window (stride 1).
+constexpr int kMaxOffsets = kMaxWindowOffsets;
 
 /// The 8 samples of a block are handled as the pairs (p, p + 4), p < 4: the lower 128 bits hold
 /// sample p, the upper sample p + 4.

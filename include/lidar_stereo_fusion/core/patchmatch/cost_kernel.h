@@ -25,6 +25,11 @@ struct alignas(16) Texel {
 /// divided by kTexelScale through the constants (alpha / 64 times min(L1, 64 lambda_col), ...).
 constexpr int kFracOne = 1 << 15;
 
+/// Largest window radius [px] (PatchMatchParams::kMaxWindowRadius, the range of window_radius
+/// in core/param_table.h), and so the most offsets per window axis: the kernels' stack buffers.
+constexpr int kMaxWindowRadius = 50;
+constexpr int kMaxWindowOffsets = 2 * kMaxWindowRadius + 1;
+
 /// Samples per SIMD block; WindowCache arrays are padded with zero-weight samples to a multiple.
 constexpr int kSimdBlock = 8;
 
