@@ -90,7 +90,7 @@ Options parseOptions(int argc, char** argv) {
   o.synthetic = cl.value("--synthetic");
   o.rings = std::stoi(cl.choice("--rings", "64", {"64", "128"}));
   o.repeat = cl.intValue("--repeat", 5, 1, 10000);
-  o.threads = cl.intValue("--threads", 0, 0, 256);
+  o.threads = cl.intValue("--threads", 0, 0, lsf::PatchMatchParams::kMaxThreads);
   if (cl.has("--method")) {
     o.method = cl.choice("--method", "", {"fused_bi", "fused_bf", "pms", "lidar_bi", "lidar_bf"});
   }

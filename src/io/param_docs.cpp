@@ -59,7 +59,8 @@ std::string markdownCell(std::string s) {
 std::string renderParamsYaml(const std::vector<ParamInfo>& rows, const std::string& header) {
   std::ostringstream out;
   std::istringstream lines(header);
-  for (std::string line; std::getline(lines, line);) out << (line.empty() ? "#" : "# " + line) << "\n";
+  for (std::string line; std::getline(lines, line);)
+    out << (line.empty() ? "#" : "# " + line) << "\n";
   std::string group = "\x01", section;
   for (const ParamInfo& p : rows) {
     const auto slash = p.name.find('/');

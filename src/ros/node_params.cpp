@@ -12,9 +12,9 @@ namespace lidar_stereo_fusion {
 void NodeParams::validate() const {
   visitParams(*this, RangeChecker{"NodeParams"});
   if (diag_min_rate > diag_max_rate) {
-    throw std::invalid_argument("NodeParams: diagnostics/min_rate must be <= diagnostics/max_rate (" +
-                                formatParamDouble(diag_max_rate) + ") Hz, got " +
-                                formatParamDouble(diag_min_rate));
+    throw std::invalid_argument(
+        "NodeParams: diagnostics/min_rate must be <= diagnostics/max_rate (" +
+        formatParamDouble(diag_max_rate) + ") Hz, got " + formatParamDouble(diag_min_rate));
   }
 }
 

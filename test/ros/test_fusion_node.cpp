@@ -643,10 +643,7 @@ TEST_F(FusionNode, NodeParametersChangeLiveWithinTheirTableRanges) {
   ASSERT_GT(depths.size(), 100u);
   std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
   const double limit = depths[depths.size() / 2];
-  mark = h().logMark();
   ASSERT_TRUE(set(one("max_output_depth", limit), nullptr));
-  EXPECT_TRUE(h().waitForLog(mark, {"parameters changed", "max_output_depth: 0.0 -> "}))
-      << h().logsSince(mark);
   auto after = goodSetStats() ? h().image("depth/image_rect") : nullptr;
   ASSERT_TRUE(after);
   const std::vector<float> limited = finiteDepths(*after);

@@ -262,8 +262,9 @@ TEST(NodeParams, YamlReadsEveryRowAndRefusesWhatTheTableRefuses) {
   EXPECT_EQ(p.max_time_offset, 0.08);
   EXPECT_EQ(p.diag_min_rate, 5.0);
 
-  EXPECT_NE(nodeYamlError("queue_size: 0\n").find("invalid value: NodeParams: queue_size must be "
-                                                   ">= 1, got 0"),
+  EXPECT_NE(nodeYamlError("queue_size: 0\n")
+                .find("invalid value: NodeParams: queue_size must be "
+                      ">= 1, got 0"),
             std::string::npos)
       << nodeYamlError("queue_size: 0\n");
   EXPECT_NE(nodeYamlError("queu_size: 3\n").find("unknown key 'queu_size'"), std::string::npos)
@@ -278,7 +279,32 @@ TEST(NodeParams, YamlReadsEveryRowAndRefusesWhatTheTableRefuses) {
   EXPECT_NE(nodeYamlError("diagnostics:\n  min_rat: 1.0\n").find("unknown key 'min_rat'"),
             std::string::npos)
       << nodeYamlError("diagnostics:\n  min_rat: 1.0\n");
-  EXPECT_NE(nodeYamlError("sync:\n  queue_size: 3\n").find("unknown key 'sync'"),
-            std::string::npos)
+  EXPECT_NE(nodeYamlError("sync:\n  queue_size: 3\n").find("unknown key 'sync'"), std::string::npos)
       << "the node's groups are no sections";
+}
+
+TEST(RosParams, LaunchArgumentsNamedLikeAParameterLeaveItsDefaultToTheTable) {
+  // An argument with its own default would override the YAML file loaded before it, and say the
+  // default a second time; empty = the file's (and so the table's) value.
+  std::set<std::string> names;
+  for (const auto& info : lsf::ros_params::listParams()) names.insert(info.name);
+  for (const auto& info : lsf::ros_params::listNodeParams()) names.insert(info.name);
+  int checked = 0;
+  for (const std::string launch :
+       {"fusion.launch", "playback.launch", "measure_live.launch", "zed_vls128.launch"}) {
+    const std::string text =
+        lsf::readTextFile(std::string(LSF_SOURCE_DIR) + "/launch/" + launch, "launch file");
+    const std::string tag = "<arg name=\"";
+    for (size_t i = text.find(tag); i != std::string::npos; i = text.find(tag, i + 1)) {
+      const size_t name_end = text.find('"', i + tag.size());
+      const std::string name = text.substr(i + tag.size(), name_end - i - tag.size());
+      const size_t close = text.find('>', name_end);
+      const std::string rest = text.substr(name_end, close - name_end);
+      if (!names.count(name) || rest.find("default=\"") == std::string::npos) continue;
+      ++checked;
+      EXPECT_NE(rest.find("default=\"\""), std::string::npos)
+          << launch << ": argument " << name << " repeats a default of the parameter tables";
+    }
+  }
+  EXPECT_GE(checked, 5);
 }

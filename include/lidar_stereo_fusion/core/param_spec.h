@@ -45,11 +45,11 @@ enum class Live { kYes, kStartup };
 
 /// One row of the parameter table.
 struct ParamSpec {
-  const char* name;   ///< the one name: YAML key, ROS parameter, dynamic_reconfigure name
-  const char* group;  ///< section in YAML, dynamic_reconfigure and the docs ("" = none)
-  ParamRange range;   ///< numbers only; bool and text parameters ignore it
-  const char* unit;   ///< "px", "m", "s", "Hz", "rows", ... ("" = none)
-  const char* doc;    ///< one line for users
+  const char* name;          ///< the one name: YAML key, ROS parameter, dynamic_reconfigure name
+  const char* group;         ///< section in YAML, dynamic_reconfigure and the docs ("" = none)
+  ParamRange range;          ///< numbers only; bool and text parameters ignore it
+  const char* unit;          ///< "px", "m", "s", "Hz", "rows", ... ("" = none)
+  const char* doc;           ///< one line for users
   const char* choices = "";  ///< text parameters: the allowed words, "a|b|c" ("" = any text)
   Live live = Live::kYes;
 };

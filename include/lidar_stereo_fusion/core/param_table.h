@@ -20,8 +20,9 @@ namespace lidar_stereo_fusion {
 template <class P, class V>
 std::enable_if_t<std::is_same_v<std::decay_t<P>, ProjectionParams>> visitParams(P&& p, V&& v) {
   const char* g = "projection";
-  v(ParamSpec{"min_depth", g, above(0), "m", "Points closer than this along the optical axis are "
-                                             "dropped"},
+  v(ParamSpec{"min_depth", g, above(0), "m",
+              "Points closer than this along the optical axis are "
+              "dropped"},
     p.min_depth);
   v(ParamSpec{"max_depth", g, above(0), "m", "Points farther than this are dropped (> min_depth)"},
     p.max_depth);
@@ -38,8 +39,9 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, BIParams>> visitParams(P&& p, V
     p.max_disp_diff);
   v(ParamSpec{"max_color_diff", g, above(0), "", "Algorithm 1 Maxcolor: RGB L1 distance (0..765)"},
     p.max_color_diff);
-  v(ParamSpec{"search_lines", g, atLeast(1), "", "Scan lines Algorithm 1 looks at up and down "
-                                                 "(paper: 1)"},
+  v(ParamSpec{"search_lines", g, atLeast(1), "",
+              "Scan lines Algorithm 1 looks at up and down "
+              "(paper: 1)"},
     p.search_lines);
   v(ParamSpec{"max_interp_rows", g, atLeast(1), "rows",
               "Eq. 3 does not bridge scan lines further apart"},
@@ -61,8 +63,7 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, BFParams>> visitParams(P&& p, V
 }
 
 template <class P, class V>
-std::enable_if_t<std::is_same_v<std::decay_t<P>, PriorConfidenceParams>> visitParams(P&& p,
-                                                                                      V&& v) {
+std::enable_if_t<std::is_same_v<std::decay_t<P>, PriorConfidenceParams>> visitParams(P&& p, V&& v) {
   const char* g = "confidence";
   v(ParamSpec{"edge_tolerance", g, atLeast(0), "px",
               "Residual two scan lines may differ by and still agree fully"},
@@ -76,8 +77,9 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PriorConfidenceParams>> visitPa
   v(ParamSpec{"removed_factor", g, within(0, 1), "",
               "Agreement factor of a gap where Algorithm 1 removed a point"},
     p.removed_factor);
-  v(ParamSpec{"near_rows", g, atLeast(0), "rows", "No distance decay within this many rows of a "
-                                                  "line"},
+  v(ParamSpec{"near_rows", g, atLeast(0), "rows",
+              "No distance decay within this many rows of a "
+              "line"},
     p.near_rows);
   v(ParamSpec{"decay_rows", g, atLeast(0), "rows",
               "e-folding distance of the decay beyond near_rows (0 = off)"},
@@ -91,21 +93,27 @@ template <class P, class V>
 std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(P&& p, V&& v) {
   using PM = PatchMatchParams;
   const char* g = "patchmatch";
-  v(ParamSpec{"window_radius", g, within(1, PM::kMaxWindowRadius), "px",
-              "Support window (2r+1)^2"},
+  v(ParamSpec{"window_radius", g, within(1, PM::kMaxWindowRadius), "px", "Support window (2r+1)^2"},
     p.window_radius);
   v(ParamSpec{"window_stride", g, atLeast(1), "px",
               "Window offsets are multiples of this (<= window_radius)"},
     p.window_stride);
-  v(ParamSpec{"window_dyadic", g, {}, "",
+  v(ParamSpec{"window_dyadic",
+              g,
+              {},
+              "",
               "Window offsets 0, +-k, +-2k, +-4k, ... (7x7 samples of 17x17); false: every k-th"},
     p.window_dyadic);
-  v(ParamSpec{"window_round", g, {}, "",
+  v(ParamSpec{"window_round",
+              g,
+              {},
+              "",
               "Only the window samples within window_radius of the centre (a disc); false: the "
               "square"},
     p.window_round);
-  v(ParamSpec{"weight_delta", g, above(0), "", "delta of the support weight exp(-|I_p - I_q|_1 / "
-                                               "delta)"},
+  v(ParamSpec{"weight_delta", g, above(0), "",
+              "delta of the support weight exp(-|I_p - I_q|_1 / "
+              "delta)"},
     p.weight_delta);
   v(ParamSpec{"image_smoothing", g, within(0, PM::kMaxImageSmoothing), "px",
               "Sigma of a 3x3 Gaussian on both images before matching (0 = off)"},
@@ -115,8 +123,9 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
   v(ParamSpec{"gamma", g, within(0, 1), "", "LiDAR disparity weight"}, p.gamma);
   v(ParamSpec{"lambda_col", g, above(0), "", "Colour truncation (RGB L1)"}, p.lambda_col);
   v(ParamSpec{"lambda_grad", g, above(0), "", "Gradient truncation"}, p.lambda_grad);
-  v(ParamSpec{"lambda_disp", g, above(0), "px", "Disparity truncation; the cost where the prior is "
-                                                "empty"},
+  v(ParamSpec{"lambda_disp", g, above(0), "px",
+              "Disparity truncation; the cost where the prior is "
+              "empty"},
     p.lambda_disp);
   v(ParamSpec{"iterations", g, within(0, PM::kMaxIterations), "",
               "PatchMatch sweeps (at the coarsest level of a coarse start)"},
@@ -127,7 +136,10 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
   v(ParamSpec{"slanted", g, {}, "", "Slanted windows (false: front-parallel)"}, p.slanted);
   v(ParamSpec{"init_from_prior", g, {}, "", "Initialise d from the LiDAR prior where it exists"},
     p.init_from_prior);
-  v(ParamSpec{"init_normal_from_prior", g, {}, "",
+  v(ParamSpec{"init_normal_from_prior",
+              g,
+              {},
+              "",
               "Slanted: initial normal from the prior's local slope"},
     p.init_normal_from_prior);
   v(ParamSpec{"use_lidar_bounds", g, {}, "", "Bound d by the scan lines above and below"},
@@ -148,7 +160,10 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
   v(ParamSpec{"median_radius", g, within(1, PM::kMaxMedianRadius), "px",
               "Half window of the weighted median over filled pixels"},
     p.median_radius);
-  v(ParamSpec{"confidence_weighting", g, {}, "",
+  v(ParamSpec{"confidence_weighting",
+              g,
+              {},
+              "",
               "Weight the LiDAR term by the prior's confidence (false: the paper's cost)"},
     p.confidence_weighting);
   v(ParamSpec{"lock_confidence", g, atLeast(0), "",
@@ -163,7 +178,10 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
   v(ParamSpec{"coarse_levels", g, within(1, PM::kMaxCoarseLevels), "",
               "Coarse start: number of reduced levels"},
     p.coarse_levels);
-  v(ParamSpec{"full_size_unbounded", g, {}, "",
+  v(ParamSpec{"full_size_unbounded",
+              g,
+              {},
+              "",
               "Search pixels without scan-line bounds at full size too (false: they keep the "
               "half-size plane)"},
     p.full_size_unbounded);
@@ -171,7 +189,10 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
               "Finest level (its reduction factor) searching pixels without scan-line bounds; 1 "
               "or a power of coarse_scale"},
     p.unbounded_scale);
-  v(ParamSpec{"skip_inconsistent", g, {}, "",
+  v(ParamSpec{"skip_inconsistent",
+              g,
+              {},
+              "",
               "After the coarse start, unbounded pixels the level below marks inconsistent are "
               "not searched"},
     p.skip_inconsistent);
@@ -179,7 +200,10 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
               "Finest level (its reduction factor) that searches at all; 1 or a power of "
               "coarse_scale"},
     p.search_scale);
-  v(ParamSpec{"intermediate_refine", g, {}, "",
+  v(ParamSpec{"intermediate_refine",
+              g,
+              {},
+              "",
               "Coarse start, the 1/2-size level of three: the right view refines and hands its "
               "planes back"},
     p.intermediate_refine);
@@ -189,18 +213,30 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
   v(ParamSpec{"fine_refine_range", g, above(0), "px",
               "Refinement range of every pixel after the coarse start"},
     p.fine_refine_range);
-  v(ParamSpec{"fine_right_view", g, {}, "",
+  v(ParamSpec{"fine_right_view",
+              g,
+              {},
+              "",
               "Full size after the coarse start: refine the right view too (false: propagation)"},
     p.fine_right_view);
-  v(ParamSpec{"fine_lr_check", g, {}, "",
+  v(ParamSpec{"fine_lr_check",
+              g,
+              {},
+              "",
               "Full size after the coarse start: check against a full-size right view (false: "
               "the 1/2-size check, up-sampled)"},
     p.fine_lr_check);
-  v(ParamSpec{"fine_subpixel", g, {}, "",
+  v(ParamSpec{"fine_subpixel",
+              g,
+              {},
+              "",
               "Full size after the coarse start: sub-pixel step on d ending the left view's "
               "search"},
     p.fine_subpixel);
-  v(ParamSpec{"fine_refine", g, {}, "",
+  v(ParamSpec{"fine_refine",
+              g,
+              {},
+              "",
               "After the coarse start: random refinement of the left view (false: propagation)"},
     p.fine_refine);
   v(ParamSpec{"num_threads", g, within(0, PM::kMaxThreads), "",

@@ -17,8 +17,9 @@ namespace lidar_stereo_fusion {
 
 /// Table visitor: sets each field whose name is in the YAML map. A key is looked up at the top
 /// level, then (the deprecated layout of the algorithm's parameters, `group_sections`) in its
-/// group's section; a name "a/b" is key b of section a. Throws std::runtime_error("params YAML <path>: key '<name>' ...") on a wrong type, a NaN or
-/// a word outside the row's choices. Ranges are the caller's validate().
+/// group's section; a name "a/b" is key b of section a. Throws std::runtime_error("params YAML
+/// <path>: key '<name>' ...") on a wrong type, a NaN or a word outside the row's choices. Ranges
+/// are the caller's validate().
 class YamlParamReader {
  public:
   YamlParamReader(const cv::FileNode& root, std::string path, bool group_sections = true)

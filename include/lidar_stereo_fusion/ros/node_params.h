@@ -20,7 +20,7 @@ struct NodeParams {
   double max_time_offset = 0.1;  ///< [s]
   double max_sweep_wait = 0.3;   ///< [s] ROS time (sim time aware)
   int sweep_buffer_size = 10;
-  double max_rate = 0.0;    ///< [Hz] 0 = no limit (dropped sets: FusionStats.rate_limited)
+  double max_rate = 0.0;     ///< [Hz] 0 = no limit (dropped sets: FusionStats.rate_limited)
   double fresh_wait = 0.05;  ///< [s] FreshWait; 0 = always the newest waiting set at once
   double tf_timeout = 0.05;  ///< [s] worker thread only
   std::string fixed_frame;   ///< ego-motion compensation through this frame; empty = off
@@ -29,9 +29,9 @@ struct NodeParams {
   double max_point_time = 0.2;  ///< [s]
   int num_rings = 64;           ///< ring recovery (ensureRings)
   int cloud_stride = 1;
-  double max_output_depth = 0.0;  ///< [m] 0 = no limit
-  double depth_color_max = 80.0;  ///< [m]
-  double input_timeout = 5.0;     ///< [s] wall time; 0 = off
+  double max_output_depth = 0.0;     ///< [m] 0 = no limit
+  double depth_color_max = 80.0;     ///< [m]
+  double input_timeout = 5.0;        ///< [s] wall time; 0 = off
   double log_throttle_period = 5.0;  ///< [s] wall time (ThrottledLog); tests set it short
   int worker_nice = 10;
   double diag_min_rate = 1.0;     ///< [Hz]
@@ -53,9 +53,13 @@ template <class P, class V>
 std::enable_if_t<std::is_same_v<std::decay_t<P>, NodeParams>> visitParams(P&& p, V&& v) {
   constexpr Live kStartup = Live::kStartup;  // read once: the synchroniser and threads use them
   const char* g = "sync";
-  v(ParamSpec{"approximate_sync", g, {}, "",
+  v(ParamSpec{"approximate_sync",
+              g,
+              {},
+              "",
               "ApproximateTime instead of ExactTime for the image set (stamps differ, e.g. KITTI)",
-              "", kStartup},
+              "",
+              kStartup},
     p.approximate_sync);
   v(ParamSpec{"queue_size", g, atLeast(1), "", "Synchroniser queue per topic", "", kStartup},
     p.queue_size);
@@ -81,13 +85,19 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, NodeParams>> visitParams(P&& p,
   v(ParamSpec{"tf_timeout", g, within(0, 10), "s",
               "LiDAR -> camera (and ego-motion) TF lookup timeout; the frame is skipped after it"},
     p.tf_timeout);
-  v(ParamSpec{"fixed_frame", g, {}, "",
+  v(ParamSpec{"fixed_frame",
+              g,
+              {},
+              "",
               "Ego-motion compensation through this frame of TF, e.g. odom (empty = off)"},
     p.fixed_frame);
   v(ParamSpec{"motion_samples", g, within(1, 100), "",
               "TF lookups per sweep, evenly over its point times"},
     p.motion_samples);
-  v(ParamSpec{"motion_failure", g, {}, "",
+  v(ParamSpec{"motion_failure",
+              g,
+              {},
+              "",
               "A frame whose ego-motion TF is missing: processed uncompensated, or skipped",
               "uncompensated|skip"},
     p.motion_failure);
