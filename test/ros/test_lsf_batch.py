@@ -304,4 +304,5 @@ def test_node_params_file_and_approximate_sync(bags):
     result = run([BAG_RUNNER, "--bag", bags[1], "--out", os.path.join(SCRATCH, "bad_np"),
                   "--node-params", bad])
     assert result.returncode == 1
-    assert bad + ": approximate_sync must be true or false" in result.stderr
+    # The one wording of the YAML reader (io/param_yaml_reader.h): the file, the key, the rule.
+    assert "params YAML " + bad + ": key 'approximate_sync' must be true or false" in result.stderr
