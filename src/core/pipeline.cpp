@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "lidar_stereo_fusion/core/both_views.h"
+#include "lidar_stereo_fusion/core/motion_compensation.h"
 
 namespace lidar_stereo_fusion {
 
@@ -155,8 +156,16 @@ FusionResult FusionPipeline::process(const FusionInput& input) {
   // beside the left).
   const auto t = Clock::now();
   SparseDisparity left_sparse, right_sparse;
+  // Points hidden beside near objects from the camera (projection.remove_hidden_beside).
+  LidarCloud visible;
+  const LidarCloud* cloud = &input.cloud;
+  if (params_.projection.remove_hidden_beside && usesLidar(method)) {
+    visible = input.cloud;
+    removePointsHiddenBeside(visible, input.T_cam_lidar, input.camera);
+    cloud = &visible;
+  }
   const auto project = [&](View view, SparseDisparity& out) {
-    out = projectCloud(input.cloud, input.T_cam_lidar, input.camera, params_.projection, view);
+    out = projectCloud(*cloud, input.T_cam_lidar, input.camera, params_.projection, view);
   };
   if (isFused(method)) {
     bothViews(

@@ -128,6 +128,44 @@ TEST(MovingRig, PointsHiddenBesideANearSurfaceAreRemoved) {
   }
 }
 
+// The same scene through the pipeline: projection.remove_hidden_beside drops exactly that point
+// before projecting (one pixel of the sparse disparity less); off by default.
+TEST(MovingRig, RemoveHiddenBesideParameterDropsThePointBeforeProjection) {
+  StereoCamera camera;
+  camera.fx = camera.fy = 100.0;
+  camera.cx = 50.0;
+  camera.cy = 20.0;
+  camera.baseline = 0.5;
+  camera.width = 101;
+  camera.height = 41;
+  FusionInput input;
+  input.camera = camera;
+  input.T_cam_lidar.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  input.T_cam_lidar.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
+  const auto add = [&](double x, double y, int ring) {
+    LidarPoint p;
+    p.x = static_cast<float>(x);
+    p.y = static_cast<float>(y);
+    p.ring = ring;
+    input.cloud.push_back(p);
+  };
+  for (double y = 0.5; y >= -0.5; y -= 0.1) add(6.0, y, 0);
+  add(21.0, 21.0 * std::tan(0.09), 0);  // hidden beside the wall
+  add(21.0, 21.0 * std::tan(0.15), 0);
+  input.left = cv::Mat(41, 101, CV_8UC3, cv::Scalar(90, 120, 150));
+  input.right = input.left.clone();
+  FusionParams params;
+  params.method = Method::kLidarBI;
+  EXPECT_FALSE(params.projection.remove_hidden_beside);
+  const FusionResult all = FusionPipeline(params).process(input);
+  params.projection.remove_hidden_beside = true;
+  const FusionResult visible = FusionPipeline(params).process(input);
+  EXPECT_EQ(all.stats.points_projected, 13);
+  EXPECT_EQ(visible.stats.points_projected, 12);
+  EXPECT_EQ(cv::countNonZero(all.sparse.disparity), cv::countNonZero(visible.sparse.disparity) + 1);
+  EXPECT_EQ(input.cloud.size(), 13u) << "the input sweep is not changed";
+}
+
 }  // namespace
 }  // namespace sim
 }  // namespace lidar_stereo_fusion

@@ -14,6 +14,9 @@ namespace lidar_stereo_fusion {
 struct ProjectionParams {
   double min_depth = 0.5;    ///< points closer than this [m] (along the optical axis) are dropped
   double max_depth = 200.0;  ///< points farther than this [m] are dropped
+  /// Drop the points the left camera cannot see beside near objects before projecting
+  /// (removePointsHiddenBeside; an ego-motion compensated sweep always gets it).
+  bool remove_hidden_beside = false;
   void validate() const;
 };
 
