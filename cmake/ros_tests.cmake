@@ -47,7 +47,10 @@ function(lsf_add_ros_test_node target)
   endif()
 endfunction()
 
-lsf_add_ros_test_node(test_fusion_node test/ros/test_fusion_node.cpp)
+# One binary of four sources (tests in this order); the .test files pick tests by --gtest_filter.
+lsf_add_ros_test_node(test_fusion_node test/ros/test_fusion_node.cpp
+  test/ros/test_fusion_node_input.cpp test/ros/test_fusion_node_params.cpp
+  test/ros/test_fusion_node_issues.cpp)
 add_rostest(test/ros/fusion_nodelet.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_node.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_approx_sync.test DEPENDENCIES test_fusion_node)

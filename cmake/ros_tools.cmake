@@ -22,7 +22,7 @@ endif()
 
 add_executable(autoware_calibration_publisher src/ros/calibration_autoware_publisher.cpp)
 add_executable(kitti_calibration_publisher src/ros/calibration_kitti_publisher.cpp)
-add_executable(kitti_to_bag src/ros/kitti_to_bag.cpp)
+add_executable(kitti_to_bag src/ros/kitti_to_bag.cpp src/ros/kitti_bag_frames.cpp)
 set(LSF_ROS_TOOLS autoware_calibration_publisher kitti_calibration_publisher kitti_to_bag)
 foreach(tool ${LSF_ROS_TOOLS})
   target_link_libraries(${tool} ${PROJECT_NAME}_calibration_msgs)

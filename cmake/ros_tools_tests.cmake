@@ -50,7 +50,8 @@ target_compile_definitions(test_calibration_publishers PRIVATE
 # KITTI raw -> kitti_to_bag -> the fusion nodelet, compared with the offline kitti_runner.
 if(TARGET kitti_runner)
   lsf_add_tools_rostest(test_kitti_bag test/ros/kitti_bag.test
-    SOURCES test/ros/test_kitti_bag.cpp test/ros/kitti_bag_expected.cpp test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
+    SOURCES test/ros/test_kitti_bag.cpp test/ros/test_kitti_bag_replay.cpp
+            test/ros/kitti_bag_expected.cpp test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
             test/ros/depth_agreement.cpp test/ros/bag_runner_check.cpp
     DEPENDS kitti_to_bag kitti_runner bag_runner ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
   target_include_directories(test_kitti_bag SYSTEM PRIVATE

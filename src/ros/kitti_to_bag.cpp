@@ -38,6 +38,7 @@
 // Only frames with image_02, image_03, a Velodyne sweep and non-blank image and Velodyne stamps
 // are written (KITTI leaves blank lines for dropped sweeps); the others are listed as skipped.
 // Exit status: 0 written, 1 bad input or write failure, 2 bad command line.
+// The choice of the frames and their stamps (and --period restamping): kitti_bag_frames.cpp.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -45,7 +46,6 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
-#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -66,6 +66,7 @@
 #include "lidar_stereo_fusion/io/kitti_sweep.h"
 #include "lidar_stereo_fusion/ros/calibration_msgs.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
+#include "lidar_stereo_fusion/ros/kitti_bag_frames.h"
 #include "lidar_stereo_fusion/ros/kitti_ego_motion.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -139,47 +140,8 @@ Options parseOptions(int argc, char** argv) {
   return options;
 }
 
-/// Timestamps [s] of a KITTI timestamps file indexed by frame (= line) number; a blank line (a
-/// dropped sample, NaN from kitti::readTimestamps) gives std::nullopt.
-std::vector<std::optional<double>> readTimestampsByFrame(const fs::path& path) {
-  std::vector<std::optional<double>> by_frame;
-  for (const double stamp : lsf::kitti::readTimestamps(path.string())) {
-    by_frame.push_back(std::isfinite(stamp) ? std::optional<double>(stamp) : std::nullopt);
-  }
-  return by_frame;
-}
-
-std::optional<double> stampOf(const std::vector<std::optional<double>>& stamps, size_t frame) {
-  return frame < stamps.size() ? stamps[frame] : std::nullopt;
-}
-
-/// Names (file stems) of the files with `extension` in `dir`, sorted; empty if no such folder.
-std::set<std::string> stemsIn(const fs::path& dir, const std::string& extension) {
-  std::set<std::string> stems;
-  if (!fs::is_directory(dir)) return stems;
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    if (entry.is_regular_file() && entry.path().extension() == extension) {
-      stems.insert(entry.path().stem().string());
-    }
-  }
-  return stems;
-}
-
-std::string joined(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& name : names) out += (out.empty() ? "" : ", ") + name;
-  return out;
-}
-
-/// One frame to write, with its stamps.
-struct FrameToWrite {
-  lsf::kitti::Frame files;
-  ros::Time image_stamp, cloud_stamp;
-  lsf::kitti::SweepClock sweep;  ///< its period and stamp_after_start give the point times
-};
-
 /// Reads a frame (images checked against the calibration's size, rings recovered by sweep order).
-lsf::kitti::FrameData loadFrame(const FrameToWrite& frame, const lsf::StereoCamera& camera) {
+lsf::kitti::FrameData loadFrame(const lsf::KittiBagFrame& frame, const lsf::StereoCamera& camera) {
   lsf::kitti::FrameData data = lsf::kitti::loadFrame(frame.files, camera);
   if (data.cloud.empty()) {
     throw std::runtime_error("KITTI: Velodyne sweep " + frame.files.velodyne + " is empty");
@@ -207,109 +169,10 @@ boost::shared_ptr<ros::M_string> latchedConnectionHeader() {
   return header;
 }
 
-/// Chooses the frames to write and their stamps; prints what is skipped and why.
-std::vector<FrameToWrite> selectFrames(const Options& options) {
-  const fs::path drive(options.drive_dir);
-  const std::vector<lsf::kitti::Frame> complete = lsf::kitti::listFrames(options.drive_dir);
-
-  // Report files that cannot form a frame (e.g. LiDAR-only frames between the stereo frames).
-  std::set<std::string> all = stemsIn(drive / "image_02" / "data", ".png");
-  const std::set<std::string> right = stemsIn(drive / "image_03" / "data", ".png");
-  const std::set<std::string> sweeps = stemsIn(drive / "velodyne_points" / "data", ".bin");
-  all.insert(right.begin(), right.end());
-  all.insert(sweeps.begin(), sweeps.end());
-  std::set<std::string> complete_names;
-  for (const auto& f : complete) complete_names.insert(f.name);
-  std::vector<std::string> incomplete;
-  for (const auto& name : all) {
-    if (!complete_names.count(name)) incomplete.push_back(name);
-  }
-  if (!incomplete.empty()) {
-    std::cerr << "kitti_to_bag: skipping " << incomplete.size()
-              << " frame(s) without all of image_02, image_03 and a Velodyne sweep: "
-              << joined(incomplete) << "\n";
-  }
-  if (complete.empty()) {
-    throw std::runtime_error("KITTI: " + options.drive_dir +
-                             " has no frame with image_02, image_03 and velodyne_points data");
-  }
-
-  // Sweep stamps: the sweep end (timestamps_end.txt), as velodyne_driver stamps a scan at its
-  // last packet; without that file, the forward-facing instant (timestamps.txt, mid-sweep).
-  const fs::path velo_dir = drive / "velodyne_points";
-  const bool have_end = fs::is_regular_file(velo_dir / "timestamps_end.txt");
-  const auto image_stamps = readTimestampsByFrame(drive / "image_02" / "timestamps.txt");
-  const auto sweep_stamps =
-      readTimestampsByFrame(velo_dir / (have_end ? "timestamps_end.txt" : "timestamps.txt"));
-  std::vector<std::optional<double>> starts;
-  if (fs::is_regular_file(velo_dir / "timestamps_start.txt")) {
-    starts = readTimestampsByFrame(velo_dir / "timestamps_start.txt");
-  }
-  if (!have_end) {
-    std::cerr << "kitti_to_bag: no velodyne_points/timestamps_end.txt: stamping sweeps at the "
-                 "forward-facing instant (timestamps.txt)\n";
-  }
-
-  std::vector<FrameToWrite> frames;
-  std::vector<std::string> unstamped;
-  for (const auto& files : complete) {
-    if (options.max_frames > 0 && static_cast<int>(frames.size()) >= options.max_frames) break;
-    const size_t index = lsf::kitti::frameIndex(files.name);
-    const auto image_stamp = stampOf(image_stamps, index);
-    const auto sweep_stamp = stampOf(sweep_stamps, index);
-    if (!image_stamp || !sweep_stamp) {
-      unstamped.push_back(files.name);
-      continue;
-    }
-    FrameToWrite frame;
-    frame.files = files;
-    frame.image_stamp = ros::Time(*image_stamp);
-    frame.cloud_stamp = ros::Time(*sweep_stamp);
-    frame.sweep = lsf::kitti::sweepClock(
-        *sweep_stamp, stampOf(starts, index).value_or(std::numeric_limits<double>::quiet_NaN()),
-        have_end);
-    frames.push_back(frame);
-  }
-  if (!unstamped.empty()) {
-    std::cerr << "kitti_to_bag: skipping " << unstamped.size()
-              << " frame(s) with no line (or a blank line) in the image_02 or velodyne_points "
-                 "timestamps: "
-              << joined(unstamped) << "\n";
-  }
-  if (frames.empty())
-    throw std::runtime_error("KITTI: no frame of " + options.drive_dir +
-                             " has both an image and a Velodyne timestamp");
-  return frames;
-}
-
-/// --period / --cycles: the frames as a stream at a fixed period, `cycles` times in a row.
-std::vector<FrameToWrite> restamped(const std::vector<FrameToWrite>& frames,
-                                    const Options& options) {
-  if (options.period <= 0.0) return frames;
-  std::vector<FrameToWrite> stream;
-  const ros::Time first = frames.front().image_stamp;
-  for (int cycle = 0; cycle < options.cycles; ++cycle) {
-    for (const FrameToWrite& frame : frames) {
-      const ros::Duration sweep_offset = frame.cloud_stamp - frame.image_stamp;
-      FrameToWrite next = frame;
-      next.image_stamp = first + ros::Duration(options.period * static_cast<double>(stream.size()));
-      next.cloud_stamp = next.image_stamp + sweep_offset;
-      if (cycle == 0 && std::abs(sweep_offset.toSec()) >= 0.5 * options.period) {
-        std::cerr << "kitti_to_bag: warning: frame " << frame.files.name << ": its sweep is "
-                  << sweep_offset.toSec()
-                  << " s from its images, half the --period or more: a consumer may pair it "
-                     "with a neighbouring frame's images\n";
-      }
-      stream.push_back(next);
-    }
-  }
-  return stream;
-}
-
 std::string partialPath(const Options& options) { return options.out + ".partial"; }
 
 void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
-              const std::vector<FrameToWrite>& frames, const lsf::KittiEgoMotion& ego) {
+              const std::vector<lsf::KittiBagFrame>& frames, const lsf::KittiEgoMotion& ego) {
   const sensor_msgs::CameraInfo left_info_base =
       lsf::rectifiedCameraInfo(calib.camera, kLeftFrame, false);
   const sensor_msgs::CameraInfo right_info_base =
@@ -343,7 +206,7 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
   }
 
   uint32_t seq = 0;
-  for (const FrameToWrite& frame : frames) {
+  for (const lsf::KittiBagFrame& frame : frames) {
     std_msgs::Header left_header, right_header, cloud_header;
     left_header.seq = right_header.seq = cloud_header.seq = seq++;
     left_header.stamp = right_header.stamp = frame.image_stamp;
@@ -377,9 +240,10 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
 }
 
 /// The drive's ego-motion for the frames' time span (oxts packets not with --period).
-lsf::KittiEgoMotion readEgoMotion(const Options& options, const std::vector<FrameToWrite>& frames) {
+lsf::KittiEgoMotion readEgoMotion(const Options& options,
+                                  const std::vector<lsf::KittiBagFrame>& frames) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const FrameToWrite& f : frames) {
+  for (const lsf::KittiBagFrame& f : frames) {
     lo = std::min({lo, f.image_stamp.toSec(), f.cloud_stamp.toSec() - f.sweep.stamp_after_start});
     hi = std::max({hi, f.image_stamp.toSec(), f.cloud_stamp.toSec()});
   }
@@ -407,7 +271,9 @@ int main(int argc, char** argv) {
       throw std::runtime_error("KITTI: --kitti-raw " + options.drive_dir + " is not a folder");
     }
     const lsf::kitti::Calibration calib = lsf::kitti::readCalibration(options.calib_dir);
-    const std::vector<FrameToWrite> frames = restamped(selectFrames(options), options);
+    const std::vector<lsf::KittiBagFrame> frames =
+        lsf::restampKittiBagFrames(lsf::selectKittiBagFrames(options.drive_dir, options.max_frames),
+                                   options.period, options.cycles);
     writeBag(options, calib, frames, readEgoMotion(options, frames));
     std::cout << "kitti_to_bag: wrote " << frames.size() << " frame(s) to " << options.out << "\n";
   } catch (const rosbag::BagException& e) {

@@ -1,5 +1,6 @@
 // Helpers of the step-by-step PatchMatch tests (test_patchmatch_steps.cpp,
-// test_patchmatch_levels.cpp): small views and parameters with exact answers.
+// test_patchmatch_levels.cpp, test_patchmatch_post_processing.cpp): small views and parameters
+// with exact answers.
 #pragma once
 
 #include <limits>

@@ -1,5 +1,6 @@
-// The test harness of test_fusion_node.cpp (one translation unit): publishes synthetic input sets
-// (and bad ones) to the fusion node and records its outputs and /rosout.
+// The test harness of the fusion node's rostest (test_fusion_node*.cpp, one gtest binary):
+// publishes synthetic input sets (and bad ones) to the fusion node and records its outputs and
+// /rosout.
 #pragma once
 
 #include <algorithm>

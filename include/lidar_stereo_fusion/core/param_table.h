@@ -26,7 +26,10 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, ProjectionParams>> visitParams(
     p.min_depth);
   v(ParamSpec{"max_depth", g, above(0), "m", "Points farther than this are dropped (> min_depth)"},
     p.max_depth);
-  v(ParamSpec{"remove_hidden_beside", g, {}, "",
+  v(ParamSpec{"remove_hidden_beside",
+              g,
+              {},
+              "",
               "Drop the points the camera cannot see beside near objects (a LiDAR off the camera "
               "sees past their sides)"},
     p.remove_hidden_beside);
