@@ -95,32 +95,44 @@ TEST(MovingRig, CompensatedAccuracyMatchesTheStaticRig) {
   EXPECT_GT(raw.bad3, 10.0 * compensated.bad3);
 }
 
-// A LiDAR 1 m behind the camera sees past a near wall (camera depth 5 m, columns 40-60) a far point
-// that the camera sees behind the wall: removed. A far point beside the wall in the camera's view,
-// and a point without a ring, stay.
-TEST(MovingRig, PointsHiddenBesideANearSurfaceAreRemoved) {
+/// The scene of the two tests below: a LiDAR 1 m behind a 101 x 41 camera, a near wall (camera
+/// depth 5 m, columns 40-60), a far point hidden beside it, a far point visible, and (with
+/// `ringless`) a far point without a ring.
+struct HiddenBesideScene {
   StereoCamera camera;
-  camera.fx = camera.fy = 100.0;
-  camera.cx = 50.0;
-  camera.cy = 20.0;
-  camera.baseline = 0.5;
-  camera.width = 101;
-  camera.height = 41;
   Eigen::Isometry3d T_cam_lidar = Eigen::Isometry3d::Identity();
-  T_cam_lidar.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;          // LiDAR x forward, y left, z up
-  T_cam_lidar.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);  // 1 m behind the camera
   LidarCloud cloud;
-  const auto add = [&](double x, double y, int ring) {
+  explicit HiddenBesideScene(bool ringless) {
+    camera.fx = camera.fy = 100.0;
+    camera.cx = 50.0;
+    camera.cy = 20.0;
+    camera.baseline = 0.5;
+    camera.width = 101;
+    camera.height = 41;
+    T_cam_lidar.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;          // LiDAR x forward, y left, z up
+    T_cam_lidar.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);  // 1 m behind the camera
+    for (double y = 0.5; y >= -0.5; y -= 0.1) add(6.0, y, 0);     // the wall, camera u 40 .. 60
+    add(21.0, 21.0 * std::tan(0.09), 0);  // beside the wall for the LiDAR; camera u 40.5: hidden
+    add(21.0, 21.0 * std::tan(0.15), 0);  // camera u 18: visible
+    if (ringless) add(21.0, 0.0, -1);     // no ring: left alone
+  }
+  void add(double x, double y, int ring) {
     LidarPoint p;
     p.x = static_cast<float>(x);
     p.y = static_cast<float>(y);
     p.ring = ring;
     cloud.push_back(p);
-  };
-  for (double y = 0.5; y >= -0.5; y -= 0.1) add(6.0, y, 0);  // the wall, camera u 40 .. 60
-  add(21.0, 21.0 * std::tan(0.09), 0);  // beside the wall for the LiDAR; camera u 40.5: hidden
-  add(21.0, 21.0 * std::tan(0.15), 0);  // camera u 18: visible
-  add(21.0, 0.0, -1);                   // no ring: left alone
+  }
+};
+
+// A LiDAR 1 m behind the camera sees past a near wall (camera depth 5 m, columns 40-60) a far point
+// that the camera sees behind the wall: removed. A far point beside the wall in the camera's view,
+// and a point without a ring, stay.
+TEST(MovingRig, PointsHiddenBesideANearSurfaceAreRemoved) {
+  HiddenBesideScene scene(true);
+  LidarCloud& cloud = scene.cloud;
+  const StereoCamera& camera = scene.camera;
+  const Eigen::Isometry3d& T_cam_lidar = scene.T_cam_lidar;
   EXPECT_EQ(removePointsHiddenBeside(cloud, T_cam_lidar, camera), 1);
   ASSERT_EQ(cloud.size(), 13u);
   for (const LidarPoint& p : cloud) {
@@ -131,27 +143,11 @@ TEST(MovingRig, PointsHiddenBesideANearSurfaceAreRemoved) {
 // The same scene through the pipeline: projection.remove_hidden_beside drops exactly that point
 // before projecting (one pixel of the sparse disparity less); off by default.
 TEST(MovingRig, RemoveHiddenBesideParameterDropsThePointBeforeProjection) {
-  StereoCamera camera;
-  camera.fx = camera.fy = 100.0;
-  camera.cx = 50.0;
-  camera.cy = 20.0;
-  camera.baseline = 0.5;
-  camera.width = 101;
-  camera.height = 41;
+  const HiddenBesideScene scene(false);
   FusionInput input;
-  input.camera = camera;
-  input.T_cam_lidar.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
-  input.T_cam_lidar.translation() = Eigen::Vector3d(0.0, 0.0, -1.0);
-  const auto add = [&](double x, double y, int ring) {
-    LidarPoint p;
-    p.x = static_cast<float>(x);
-    p.y = static_cast<float>(y);
-    p.ring = ring;
-    input.cloud.push_back(p);
-  };
-  for (double y = 0.5; y >= -0.5; y -= 0.1) add(6.0, y, 0);
-  add(21.0, 21.0 * std::tan(0.09), 0);  // hidden beside the wall
-  add(21.0, 21.0 * std::tan(0.15), 0);
+  input.camera = scene.camera;
+  input.T_cam_lidar = scene.T_cam_lidar;
+  input.cloud = scene.cloud;
   input.left = cv::Mat(41, 101, CV_8UC3, cv::Scalar(90, 120, 150));
   input.right = input.left.clone();
   FusionParams params;
