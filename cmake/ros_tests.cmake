@@ -18,6 +18,7 @@ set(LSF_ROS_TEST_DEFINITIONS
   LSF_BINARY_DIR="${CMAKE_CURRENT_BINARY_DIR}")
 
 catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp test/ros/test_ros_params.cpp
+  test/ros/test_frame_matcher.cpp
   test/ros/test_input_attacks.cpp
   test/ros/test_point_time.cpp
   test/ros/test_node_parts.cpp test/ros/test_launch_files.cpp test/ros/run_command.cpp
