@@ -35,16 +35,24 @@ std::string rangeProblem(const ParamSpec& spec, double value) {
   return text + ", got " + number(value);
 }
 
-std::string choiceProblem(const ParamSpec& spec, const std::string& value) {
-  const std::string choices = spec.choices;
-  if (choices.empty()) return {};
-  std::string list;
+std::vector<std::string> choiceWords(const std::string& choices) {
+  std::vector<std::string> words;
+  if (choices.empty()) return words;
   for (size_t start = 0; start <= choices.size();) {
     const size_t end = std::min(choices.find('|', start), choices.size());
-    const std::string word = choices.substr(start, end - start);
+    words.push_back(choices.substr(start, end - start));
+    start = end + 1;
+  }
+  return words;
+}
+
+std::string choiceProblem(const ParamSpec& spec, const std::string& value) {
+  const std::vector<std::string> words = choiceWords(spec.choices);
+  if (words.empty()) return {};
+  std::string list;
+  for (const std::string& word : words) {
     if (word == value) return {};
     list += (list.empty() ? "" : ", ") + word;
-    start = end + 1;
   }
   return std::string(spec.name) + " must be one of " + list + ", got '" + value + "'";
 }

@@ -12,7 +12,7 @@ namespace {
 /// "a | b | c" of "a|b|c".
 std::string choiceList(const std::string& choices) {
   std::string out;
-  for (char c : choices) out += c == '|' ? std::string(" | ") : std::string(1, c);
+  for (const std::string& word : choiceWords(choices)) out += (out.empty() ? "" : " | ") + word;
   return out;
 }
 
@@ -127,9 +127,7 @@ std::string renderFusionCfg(const std::vector<ParamInfo>& rows) {
     std::string edit;
     if (!p.choices.empty()) {
       out << p.name << "_enum = gen.enum([";
-      std::string rest = p.choices + "|";
-      for (size_t i = 0, j; (j = rest.find('|', i)) != std::string::npos; i = j + 1) {
-        const std::string word = rest.substr(i, j - i);
+      for (const std::string& word : choiceWords(p.choices)) {
         out << "\n    gen.const(\"" << word << "\", str_t, \"" << word << "\", \"" << word
             << "\"),";
       }

@@ -10,12 +10,19 @@
 namespace lidar_stereo_fusion {
 
 void NodeParams::validate() const {
-  visitParams(*this, RangeChecker{"NodeParams"});
+  requireRanges("NodeParams", *this);
   if (diag_min_rate > diag_max_rate) {
     throw std::invalid_argument(
         "NodeParams: diagnostics/min_rate must be <= diagnostics/max_rate (" +
         formatParamDouble(diag_max_rate) + ") Hz, got " + formatParamDouble(diag_min_rate));
   }
+}
+
+std::vector<ParamInfo> nodeParamTable() {
+  std::vector<ParamInfo> out;
+  const NodeParams defaults;
+  visitParams(defaults, ParamLister{out});
+  return out;
 }
 
 NodeParams readNodeParamsYaml(const std::string& path) {
@@ -24,9 +31,7 @@ NodeParams readNodeParamsYaml(const std::string& path) {
   NodeParams p;
   if (root.empty() || root.isNone()) return p;
   if (!root.isMap()) throw std::runtime_error("params YAML " + path + ": top level is not a map");
-  std::vector<ParamInfo> table;
-  visitParams(p, ParamLister{table});
-  rejectUnknownParamKeys(root, path, table, /*group_sections=*/false);
+  rejectUnknownParamKeys(root, path, nodeParamTable(), /*group_sections=*/false);
   visitParams(p, YamlParamReader(root, path, /*group_sections=*/false));
   try {
     p.validate();

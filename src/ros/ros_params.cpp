@@ -265,12 +265,7 @@ struct LiveSet {
 
 std::vector<ParamInfo> listParams() { return paramTable(); }
 
-std::vector<ParamInfo> listNodeParams() {
-  std::vector<ParamInfo> out;
-  const NodeParams defaults;
-  visitParams(defaults, ParamLister{out});
-  return out;
-}
+std::vector<ParamInfo> listNodeParams() { return nodeParamTable(); }
 
 FusionParams readParams(const ros::NodeHandle& pnh, const FusionParams& base,
                         std::vector<std::string>* errors) {

@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 namespace lidar_stereo_fusion {
 
@@ -56,6 +57,9 @@ struct ParamSpec {
 
 /// "" when `value` is allowed, else "<name> must be <range> <unit>, got <value>".
 std::string rangeProblem(const ParamSpec& spec, double value);
+
+/// The allowed words of a text parameter: "a|b|c" -> {a, b, c} ({} when `choices` is empty).
+std::vector<std::string> choiceWords(const std::string& choices);
 
 /// "" when `value` is one of spec.choices (or choices is empty), else
 /// "<name> must be one of a, b, c, got '<value>'".

@@ -8,10 +8,13 @@
 
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "lidar_stereo_fusion/core/param_spec.h"
 
 namespace lidar_stereo_fusion {
+
+struct ParamInfo;  // io/param_table.h
 
 /// Parameters of the ROS layer (the nodelet's private namespace; bag_runner --node-params).
 struct NodeParams {
@@ -42,6 +45,9 @@ struct NodeParams {
   /// its row's range or choices, or when the diagnostics' rates are the wrong way round.
   void validate() const;
 };
+
+/// Every row with its default as text, in table order (io/param_table.h's ParamInfo).
+std::vector<ParamInfo> nodeParamTable();
 
 /// Node parameters from a YAML file in the layout of config/fusion_node.yaml (bag_runner
 /// --node-params): keys not in the file keep their defaults. Throws std::runtime_error naming the
