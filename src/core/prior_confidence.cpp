@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -105,18 +106,41 @@ int fillPriorHoles(cv::Mat1f& prior, cv::Mat1f& confidence, const PriorConfidenc
     confidence(y, x) = hole;
     ++filled;
   };
+  // The LiDAR's view of each column starts at its top value. A row crosses the tops of many
+  // columns: the top beam's arc spans rows, and a near object's top point sits higher in the image
+  // than a far one's (the LiDAR is above the camera). A row fill that carried a near object's
+  // disparity sideways above a column's top would paint near planes over the far surfaces there
+  // (bands along the top scan line). So above its top value, a column takes a fill value only if
+  // it is no nearer than that top value (+ edge_tolerance): the same surface seen by a neighbour
+  // where this column's top beam returned nothing, or one behind it.
+  std::vector<int> top(static_cast<size_t>(prior.cols), prior.rows);
+  std::vector<float> top_value(static_cast<size_t>(prior.cols),
+                               std::numeric_limits<float>::infinity());
+  for (int y = prior.rows - 1; y >= 0; --y) {
+    const float* d = prior[y];
+    for (int x = 0; x < prior.cols; ++x) {
+      if (d[x] > 0.f) {
+        top[x] = y;
+        top_value[x] = d[x];
+      }
+    }
+  }
+  const float tolerance = static_cast<float>(params.edge_tolerance);
   // Rows: a gap between two values takes the nearer (larger) one; the row ends take the first and
   // last value.
   for (int y = 0; y < prior.rows; ++y) {
     const float* d = prior[y];
+    const auto fill = [&](int u, float value) {
+      if (y >= top[u] || value <= top_value[u] + tolerance) set(y, u, value);
+    };
     int last = -1;  // column of the last value seen in this row
     for (int x = 0; x < prior.cols; ++x) {
       if (!(d[x] > 0.f)) continue;
       const float value = last < 0 ? d[x] : std::max(d[last], d[x]);
-      for (int u = last + 1; u < x; ++u) set(y, u, value);
+      for (int u = last + 1; u < x; ++u) fill(u, value);
       last = x;
     }
-    for (int u = last + 1; last >= 0 && u < prior.cols; ++u) set(y, u, d[last]);
+    for (int u = last + 1; last >= 0 && u < prior.cols; ++u) fill(u, d[last]);
   }
   // Columns: below the bottom value, the bottom value (the ground the LiDAR's lowest beam missed).
   for (int x = 0; x < prior.cols; ++x) {

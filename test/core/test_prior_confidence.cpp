@@ -146,6 +146,28 @@ TEST(FillPriorHoles, RowGapsTakeTheNearerEndRowEndsAndTheBottomAreExtended) {
   EXPECT_EQ(filled, 4 + 2 * 6);
 }
 
+TEST(FillPriorHoles, ARowFillNeverCarriesANearerValueAboveAColumnsTop) {
+  // A near pole's top point (40 px) sits at row 0 in column 0; the far facade's top line (13 px)
+  // is at row 2 in columns 1..5, except column 3, whose top beam returned nothing: its top is the
+  // ground (20 px) at row 3.
+  cv::Mat1f prior = cv::Mat1f::zeros(5, 6);
+  cv::Mat1f conf = cv::Mat1f::zeros(5, 6);
+  for (int y = 0; y < 5; ++y) prior(y, 0) = 40.f;
+  for (int x = 1; x < 6; ++x) {
+    if (x != 3) prior(2, x) = 13.f;
+    for (int y = 3; y < 5; ++y) prior(y, x) = 20.f;
+  }
+  lsf::PriorConfidenceParams p;
+  lsf::fillPriorHoles(prior, conf, p);
+  for (int x = 1; x < 6; ++x) {
+    EXPECT_EQ(prior(0, x), 0.f) << "no near band above the facade's top, column " << x;
+    EXPECT_EQ(prior(1, x), 0.f) << x;
+  }
+  EXPECT_EQ(prior(2, 3), 13.f) << "the facade seen beside a dropout fills it (not nearer)";
+  EXPECT_FLOAT_EQ(conf(2, 3), 0.2f);
+  EXPECT_EQ(prior(2, 1), 13.f) << "measured values stay";
+}
+
 TEST(FillPriorHoles, ZeroHoleConfidenceFillsNothing) {
   cv::Mat1f prior = cv::Mat1f::zeros(2, 3);
   prior(0, 0) = 4.f;

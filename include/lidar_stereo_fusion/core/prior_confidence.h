@@ -57,7 +57,9 @@ cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
 /// row, a gap between two prior values takes the nearer of the two (the larger disparity), as the
 /// KITTI devkit's interpolateBackground does for the benchmark, and the row ends take the first /
 /// last value; below the bottom value of a column, that value. Rows without a value and pixels
-/// above the top scan line (beyond the LiDAR's field of view) stay empty. Filled pixels get
+/// above the top value of their own column (beyond the LiDAR's field of view there; a row fill
+/// never crosses it, so a near object's top points do not spread over the far surfaces beside and
+/// above them) stay empty. Filled pixels get
 /// confidence params.hole_confidence: a weak pull that decides where the images cannot (a dark,
 /// textureless car body that returned few LiDAR points) and yields to them where they can. Nothing
 /// happens when hole_confidence is 0. Returns the number of pixels filled. Throws
