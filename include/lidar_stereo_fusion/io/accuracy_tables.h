@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/io/kitti_accumulated.h"
 
 namespace lidar_stereo_fusion {
 
@@ -22,5 +23,13 @@ std::string formatKittiLayout(const LayoutScores<DepthMetrics>& layout);
 /// share of the reference pixels [%].
 std::string formatMiddleburyRegions(const LayoutScores<DisparityMetrics>& layout);
 std::string formatKittiRegions(const LayoutScores<DepthMetrics>& layout);
+
+/// Depth-band table of a KITTI layout: rows = methods, MAE [mm] and RMSE [mm] over all reference
+/// pixels and in the bands < 10 m, 10-30 m, >= 30 m of the reference depth; a last row gives each
+/// band's share of the reference pixels [%].
+std::string formatDepthBands(const LayoutScores<DepthMetrics>& layout);
+
+/// How an accumulated reference was built (io/kitti_accumulated.h), as a two-column table.
+std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference);
 
 }  // namespace lidar_stereo_fusion
