@@ -18,21 +18,25 @@ const std::vector<Region> kSplitRegions = {Region::kAbove, Region::kInside, Regi
                                            Region::kElsewhere};
 const std::vector<Region> kBands = {Region::kAll, Region::kNear, Region::kMid, Region::kFar};
 
-/// Adds "raw coverage %" and "time s" columns to a table from report.h (same row order).
+/// Adds "raw coverage %" and "ms / <item>" (the method's wall time per scene / frame) columns to a
+/// table from report.h (same row order).
 template <typename Metrics>
-std::string withExtraColumns(const std::string& table, const LayoutScores<Metrics>& layout) {
+std::string withExtraColumns(const std::string& table, const LayoutScores<Metrics>& layout,
+                             const std::string& item) {
+  const double items = std::max<size_t>(1, layout.items.size());
   std::string out;
   size_t start = 0;
   for (int line = 0; start < table.size(); ++line) {
     const size_t end = table.find('\n', start);
     std::string text = table.substr(start, end - start);
     if (line == 0) {
-      text += " raw coverage % | time s |";
+      text += " raw coverage % | ms / " + item + " |";
     } else if (line == 1) {
       text += "---|---|";
     } else {
       const MethodScores<Metrics>& m = layout.methods[line - 2];
-      text += " " + format("%.1f", 100 * m.raw_coverage) + " | " + format("%.1f", m.seconds) + " |";
+      text += " " + format("%.1f", 100 * m.raw_coverage) + " | " +
+              format("%.1f", 1000 * m.seconds / items) + " |";
     }
     out += text + "\n";
     start = end + 1;
@@ -76,7 +80,7 @@ std::string regionTable(const LayoutScores<Metrics>& layout, const std::vector<R
 std::string formatMiddleburyLayout(const LayoutScores<DisparityMetrics>& layout) {
   std::vector<DisparityRow> rows;
   for (const auto& m : layout.methods) rows.push_back({m.name, m.mean[0]});
-  std::string out = withExtraColumns(formatDisparityTable(rows), layout);
+  std::string out = withExtraColumns(formatDisparityTable(rows), layout, "scene");
   std::vector<std::string> header = {"method"};
   for (const std::string& item : layout.items) {
     header.push_back(item + " MAE px");
@@ -97,7 +101,7 @@ std::string formatMiddleburyLayout(const LayoutScores<DisparityMetrics>& layout)
 std::string formatKittiLayout(const LayoutScores<DepthMetrics>& layout) {
   std::vector<DepthRow> rows;
   for (const auto& m : layout.methods) rows.push_back({m.name, m.mean[0]});
-  return withExtraColumns(formatDepthTable(rows), layout);
+  return withExtraColumns(formatDepthTable(rows), layout, "frame");
 }
 
 std::string formatMiddleburyRegions(const LayoutScores<DisparityMetrics>& layout) {

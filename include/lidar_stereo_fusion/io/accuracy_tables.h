@@ -10,12 +10,13 @@
 namespace lidar_stereo_fusion {
 
 /// Main table of a Middlebury layout: one row per method (mean of the scenes, region "all"), the
-/// columns of formatDisparityTable plus raw coverage [%] (before the devkit fill) and time [s].
+/// columns of formatDisparityTable plus raw coverage [%] (before the devkit fill) and the wall
+/// time per scene [ms].
 /// Then a per-scene table: MAE [px] and bad-2 [%] per scene.
 std::string formatMiddleburyLayout(const LayoutScores<DisparityMetrics>& layout);
 
 /// Main table of a KITTI layout: one row per method (mean over frames, region "all"), the columns
-/// of formatDepthTable plus raw coverage [%] and time [s].
+/// of formatDepthTable plus raw coverage [%] and the wall time per frame [ms].
 std::string formatKittiLayout(const LayoutScores<DepthMetrics>& layout);
 
 /// Per-region table: rows = methods, for each region (above, inside, edge, elsewhere) MAE [px]
