@@ -138,7 +138,7 @@ std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference)
       {"removed: no own point in the check window", share(reference.removed_unverified, other)});
   out += row({"removed: outside the window's own depth range",
               share(reference.removed_disagreeing, other)});
-  out += row({"other sweeps vs own sweep before removal, |dz| / z median / p90 [%]",
+  out += row({"other vs own sweep before removal: relative difference median / p90 %",
               format("%.2f", 100 * reference.median_relative_difference) + " / " +
                   format("%.2f", 100 * reference.p90_relative_difference) + " over " +
                   std::to_string(reference.compared_pixels) + " pixels"});
