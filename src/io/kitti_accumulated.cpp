@@ -118,7 +118,7 @@ AccumulatedDepth accumulateDepth(const std::vector<PosedSweep>& sweeps, const St
       ++out.other_points;
       if (z_max(y, x) <= 0.f) {
         ++out.removed_unverified;
-        return false;
+        return params.keep_unverified;
       }
       if (z < lo * z_min(y, x) || z > hi * z_max(y, x)) {
         ++out.removed_disagreeing;

@@ -76,6 +76,12 @@ TEST(AccumulatedDepth, KeepsPointsOnTheOwnSurfaceAndRemovesTheOthers) {
   EXPECT_EQ(out.own(2, 0), 255);
   EXPECT_EQ(out.own(4, 5), 0);
   EXPECT_EQ(out.compared_pixels, 0);  // no other point on an own pixel
+  kitti::AccumulationParams keep = params;
+  keep.keep_unverified = true;
+  const kitti::AccumulatedDepth kept = kitti::accumulateDepth(sweeps, camera(), keep);
+  EXPECT_EQ(kept.removed_unverified, 1);  // still counted
+  EXPECT_EQ(kept.pixels, out.pixels + 1);
+  EXPECT_NEAR(kept.depth(8, 16), 10.f, 1e-5);
 }
 
 TEST(AccumulatedDepth, ComparesTheOtherSweepsWithTheOwnOneBeforeRemoval) {

@@ -30,8 +30,11 @@ struct AccumulationParams {
   /// +-check_half_width columns and +-check_half_height rows of its pixel, and its depth z lies in
   /// [z_min (1 - tolerance), z_max (1 + tolerance)] of those points' depths.
   int check_half_width = 2;   ///< [px]
-  int check_half_height = 3;  ///< [px] (the HDL-64E's rings are 4-6 px apart in KITTI's image)
+  int check_half_height = 3;  ///< [px] (the HDL-64E's rings are 4-6 rows apart in KITTI's image)
   double tolerance = 0.05;    ///< relative depth tolerance [-]
+  /// Keep the points without an own point in the window (they are counted as removed_unverified
+  /// all the same); for measuring what the rule's first half removes.
+  bool keep_unverified = false;
   /// Throws std::invalid_argument naming the first impossible value.
   void validate() const;
 };
