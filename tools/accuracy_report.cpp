@@ -122,6 +122,11 @@ Options parseOptions(int argc, char** argv) {
   o.middlebury = o.middlebury && anyChosen(o.layouts, lsf::middleburyLayoutNames());
   o.kitti = o.kitti && anyChosen(o.layouts, lsf::kittiLayoutNames());
   o.dense = o.dense && anyChosen(o.layouts, lsf::denseLayoutNames());
+  if (!o.help && !o.middlebury && !o.kitti && !o.dense) {
+    throw lsf::UsageError(
+        "--protocols and --layouts leave nothing to run (no chosen layout "
+        "belongs to a chosen protocol)");
+  }
   return o;
 }
 
@@ -129,11 +134,8 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-int run(const Options& o) {
-  if (!std::filesystem::is_directory(o.data)) {
-    throw std::runtime_error("data folder not found: " + o.data +
-                             " (pass --data <dir> or set LSF_DATA_DIR)");
-  }
+/// The protocols' options from the command line's.
+lsf::AccuracyOptions accuracyOptions(const Options& o) {
   lsf::AccuracyOptions options;
   options.data_dir = o.data;
   options.kitti_frames = o.frames;
@@ -155,43 +157,56 @@ int run(const Options& o) {
   } else {
     std::cout << "> note: " << paper << " not found: the 'paper' row is skipped.\n\n";
   }
+  return options;
+}
+
+void printMiddlebury(const lsf::AccuracyOptions& options) {
+  const auto t = std::chrono::steady_clock::now();
+  for (const auto& layout : lsf::runMiddleburyProtocol(options)) {
+    std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
+              << lsf::formatMiddleburyLayout(layout) << "\nPer region (mean of scenes):\n\n"
+              << lsf::formatMiddleburyRegions(layout) << "\n";
+  }
+  std::cout << "Middlebury protocol: " << secondsSince(t) << " s\n\n";
+}
+
+void printKitti(const lsf::AccuracyOptions& options) {
+  const auto t = std::chrono::steady_clock::now();
+  for (const auto& layout : lsf::runKittiProtocol(options)) {
+    std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
+              << lsf::formatKittiLayout(layout) << "\nPer depth band (mean of frames):\n\n"
+              << lsf::formatDepthBands(layout) << "\nPer region (mean of frames):\n\n"
+              << lsf::formatKittiRegions(layout) << "\n";
+  }
+  std::cout << "KITTI protocol: " << secondsSince(t) << " s"
+            << (options.kitti_pms ? "" : " (without pms)") << "\n\n";
+}
+
+void printDense(const lsf::AccuracyOptions& options) {
+  const auto t = std::chrono::steady_clock::now();
+  const lsf::DenseProtocolResult dense = lsf::runDenseProtocol(options);
+  std::cout << "## dense: " << dense.layout.description << "\n\n"
+            << lsf::formatKittiLayout(dense.layout)
+            << "\nPer depth band of the reference depth:\n\n"
+            << lsf::formatDepthBands(dense.layout) << "\nPer region:\n\n"
+            << lsf::formatKittiRegions(dense.layout) << "\nThe reference:\n\n"
+            << lsf::formatAccumulatedReference(dense.reference) << "\n";
+  std::cout << "Dense protocol: " << secondsSince(t) << " s"
+            << (options.kitti_pms ? "" : " (without pms)") << "\n";
+}
+
+int run(const Options& o) {
+  if (!std::filesystem::is_directory(o.data)) {
+    throw std::runtime_error("data folder not found: " + o.data +
+                             " (pass --data <dir> or set LSF_DATA_DIR)");
+  }
+  const lsf::AccuracyOptions options = accuracyOptions(o);
   std::cout << "Scoring: empty pixels filled like the KITTI devkit's interpolateBackground "
                "(gaps in a row take the nearer neighbour), then scored; 'raw coverage' is before "
                "the fill. Regions: see io/accuracy_protocols.h.\n\n";
-  if (o.middlebury) {
-    const auto t = std::chrono::steady_clock::now();
-    const auto layouts = lsf::runMiddleburyProtocol(options);
-    for (const auto& layout : layouts) {
-      std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
-                << lsf::formatMiddleburyLayout(layout) << "\nPer region (mean of scenes):\n\n"
-                << lsf::formatMiddleburyRegions(layout) << "\n";
-    }
-    std::cout << "Middlebury protocol: " << secondsSince(t) << " s\n\n";
-  }
-  if (o.kitti) {
-    const auto t = std::chrono::steady_clock::now();
-    const auto layouts = lsf::runKittiProtocol(options);
-    for (const auto& layout : layouts) {
-      std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
-                << lsf::formatKittiLayout(layout) << "\nPer depth band (mean of frames):\n\n"
-                << lsf::formatDepthBands(layout) << "\nPer region (mean of frames):\n\n"
-                << lsf::formatKittiRegions(layout) << "\n";
-    }
-    std::cout << "KITTI protocol: " << secondsSince(t) << " s"
-              << (o.kitti_pms ? "" : " (without pms)") << "\n\n";
-  }
-  if (o.dense) {
-    const auto t = std::chrono::steady_clock::now();
-    const lsf::DenseProtocolResult dense = lsf::runDenseProtocol(options);
-    std::cout << "## dense: " << dense.layout.description << "\n\n"
-              << lsf::formatKittiLayout(dense.layout)
-              << "\nPer depth band of the reference depth:\n\n"
-              << lsf::formatDepthBands(dense.layout) << "\nPer region:\n\n"
-              << lsf::formatKittiRegions(dense.layout) << "\nThe reference:\n\n"
-              << lsf::formatAccumulatedReference(dense.reference) << "\n";
-    std::cout << "Dense protocol: " << secondsSince(t) << " s"
-              << (o.kitti_pms ? "" : " (without pms)") << "\n";
-  }
+  if (o.middlebury) printMiddlebury(options);
+  if (o.kitti) printKitti(options);
+  if (o.dense) printDense(options);
   return 0;
 }
 
