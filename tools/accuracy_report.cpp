@@ -1,6 +1,7 @@
 // accuracy_report: every method on every accuracy protocol (Middlebury pseudo-LiDAR layouts, KITTI
-// ring hold-out), with per-region figures, as Markdown tables. The protocols themselves are in
-// io/accuracy_protocols.h; this tool parses options and prints.
+// ring hold-out, KITTI dense LiDAR against an accumulated reference), with per-region figures, as
+// Markdown tables. The protocols themselves are in io/accuracy_protocols.h and
+// io/accuracy_dense.h; this tool parses options and prints.
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "lidar_stereo_fusion/io/accuracy_dense.h"
 #include "lidar_stereo_fusion/io/accuracy_protocols.h"
 #include "lidar_stereo_fusion/io/accuracy_tables.h"
 #include "lidar_stereo_fusion/io/cli.h"
@@ -22,35 +24,58 @@ namespace {
 const char* const kUsage = R"(Usage: accuracy_report [options]
 
 Runs every method (fused = FusionParams() defaults, paper = config/paper.yaml, lidar_bi, lidar_bf,
-pms, "lidar_bi else pms", nearest) on the accuracy protocols and prints Markdown tables: one per
-layout (rows = methods, columns = metrics, mean over scenes / frames), then the per-region tables
-(above the LiDAR, inside, depth edge, elsewhere inside). Empty pixels are filled like the KITTI
-devkit (interpolateBackground) before scoring.
+pms, "lidar_bi else pms", nearest, ip_basic) on the accuracy protocols and prints Markdown tables:
+one per layout (rows = methods, columns = metrics, mean over scenes / frames), then the
+per-region tables (above the LiDAR, inside, depth edge, elsewhere inside) and, on KITTI, the
+depth bands (< 10 m, 10-30 m, >= 30 m of the reference depth). Empty pixels are filled like the
+KITTI devkit (interpolateBackground) before scoring.
 
-  Middlebury cones + teddy: mb64 (64 ground-truth rows), mb16 (16 rows), mb42low (42 rows over
+  middlebury: cones + teddy: mb64 (64 ground-truth rows), mb16 (16 rows), mb42low (42 rows over
     the lower 2/3); errors in disparity px over every ground-truth pixel.
-  KITTI drive 0009: ring32 (rings % 2 == 0 fed), ring16 (rings % 4 == 0 fed); the other rings'
+  kitti: drive 0009: ring32 (rings % 2 == 0 fed), ring16 (rings % 4 == 0 fed); the other rings'
     points are the reference depth.
+  dense: drive 0009 frame 20: the full sweep fed, scored against the depth accumulated from
+    sweeps 15-25 with the OXTS poses (points disagreeing with frame 20's sweep removed).
 
 Options:
   --data <dir>          the shared data folder (default: env LSF_DATA_DIR, else the build's
                         ../shared/data next to the source tree)
-  --protocols <list>    comma-separated subset of middlebury,kitti (default both)
-  --frames N            the first N KITTI frames (default all 11)
-  --no-kitti-pms        skip pms and "lidar_bi else pms" on KITTI (~15 s per frame)
+  --protocols <list>    comma-separated subset of middlebury,kitti,dense (default all)
+  --layouts <list>      comma-separated subset of mb64,mb16,mb42low,ring32,ring16,dense (default
+                        all); a protocol runs only when one of its layouts is chosen
+  --frames N            the first N KITTI ring hold-out frames (default all 11)
+  --no-kitti-pms        skip pms and "lidar_bi else pms" on KITTI, ring and dense (~15 s a frame)
   --params <yaml>       parameters of the "fused" row (and the base of lidar_*, pms), e.g. to
                         compare a tuning against the defaults; default FusionParams()
   --methods <list>      comma-separated subset of the rows: fused, paper, lidar_bi, lidar_bf, pms,
-                        "lidar_bi else pms", nearest (default all)
+                        "lidar_bi else pms", nearest, ip_basic (default all)
+  --ip-basic-blur <b>   IP-Basic's last blur: gaussian (the paper's, default), bilateral, none
   --help                this text
 )";
 
 struct Options {
-  std::string data, params;
-  std::set<std::string> methods;
-  bool middlebury = true, kitti = true, kitti_pms = true, help = false;
+  std::string data, params, ip_basic_blur = "gaussian";
+  std::set<std::string> methods, layouts;
+  bool middlebury = true, kitti = true, dense = true, kitti_pms = true, help = false;
   int frames = 0;
 };
+
+std::set<std::string> splitList(const std::string& text) {
+  std::set<std::string> items;
+  std::stringstream list(text);
+  std::string item;
+  while (std::getline(list, item, ',')) items.insert(item);
+  return items;
+}
+
+/// True when `layouts` is empty or holds one of `names`.
+bool anyChosen(const std::set<std::string>& layouts, const std::vector<std::string>& names) {
+  if (layouts.empty()) return true;
+  for (const std::string& n : names) {
+    if (layouts.count(n) > 0) return true;
+  }
+  return false;
+}
 
 std::string defaultDataDir() {
   if (const char* env = std::getenv("LSF_DATA_DIR"); env != nullptr && *env != '\0') return env;
@@ -59,7 +84,8 @@ std::string defaultDataDir() {
 
 Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(argc, argv,
-                            {"--data", "--protocols", "--frames", "--params", "--methods"},
+                            {"--data", "--protocols", "--layouts", "--frames", "--params",
+                             "--methods", "--ip-basic-blur"},
                             {"--no-kitti-pms", "--help"});
   Options o;
   o.help = cl.has("--help");
@@ -67,25 +93,39 @@ Options parseOptions(int argc, char** argv) {
   o.frames = cl.intValue("--frames", 0, 1, 1000);
   o.kitti_pms = !cl.has("--no-kitti-pms");
   o.params = cl.value("--params", "");
-  if (cl.has("--methods")) {
-    std::stringstream list(cl.value("--methods"));
-    std::string item;
-    while (std::getline(list, item, ',')) o.methods.insert(item);
+  o.ip_basic_blur = cl.choice("--ip-basic-blur", "gaussian", {"gaussian", "bilateral", "none"});
+  if (cl.has("--methods")) o.methods = splitList(cl.value("--methods"));
+  if (cl.has("--layouts")) o.layouts = splitList(cl.value("--layouts"));
+  for (const std::string& layout : o.layouts) {
+    if (!anyChosen({layout}, lsf::middleburyLayoutNames()) &&
+        !anyChosen({layout}, lsf::kittiLayoutNames()) &&
+        !anyChosen({layout}, lsf::denseLayoutNames())) {
+      throw lsf::UsageError("--layouts: unknown layout '" + layout +
+                            "' (valid: mb64, mb16, mb42low, ring32, ring16, dense)");
+    }
   }
   if (cl.has("--protocols")) {
-    o.middlebury = o.kitti = false;
-    std::stringstream list(cl.value("--protocols"));
-    std::string item;
-    while (std::getline(list, item, ',')) {
+    o.middlebury = o.kitti = o.dense = false;
+    for (const std::string& item : splitList(cl.value("--protocols"))) {
       if (item == "middlebury") {
         o.middlebury = true;
       } else if (item == "kitti") {
         o.kitti = true;
+      } else if (item == "dense") {
+        o.dense = true;
       } else {
         throw lsf::UsageError("--protocols: unknown protocol '" + item +
-                              "' (valid: middlebury, kitti)");
+                              "' (valid: middlebury, kitti, dense)");
       }
     }
+  }
+  o.middlebury = o.middlebury && anyChosen(o.layouts, lsf::middleburyLayoutNames());
+  o.kitti = o.kitti && anyChosen(o.layouts, lsf::kittiLayoutNames());
+  o.dense = o.dense && anyChosen(o.layouts, lsf::denseLayoutNames());
+  if (!o.help && !o.middlebury && !o.kitti && !o.dense) {
+    throw lsf::UsageError(
+        "--protocols and --layouts leave nothing to run (no chosen layout "
+        "belongs to a chosen protocol)");
   }
   return o;
 }
@@ -94,17 +134,18 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-int run(const Options& o) {
-  if (!std::filesystem::is_directory(o.data)) {
-    throw std::runtime_error("data folder not found: " + o.data +
-                             " (pass --data <dir> or set LSF_DATA_DIR)");
-  }
+/// The protocols' options from the command line's.
+lsf::AccuracyOptions accuracyOptions(const Options& o) {
   lsf::AccuracyOptions options;
   options.data_dir = o.data;
   options.kitti_frames = o.frames;
   options.kitti_pms = o.kitti_pms;
   options.progress = &std::cerr;
   options.methods = o.methods;
+  options.layouts = o.layouts;
+  options.ip_basic.blur = o.ip_basic_blur == "bilateral" ? lsf::IpBasicBlur::kBilateral
+                          : o.ip_basic_blur == "none"    ? lsf::IpBasicBlur::kNone
+                                                         : lsf::IpBasicBlur::kGaussian;
   if (!o.params.empty()) lsf::loadParamsYaml(o.params, options.fused);
   lsf::applySimdEnvironment(options.fused);
   const std::string paper = std::string(LSF_SOURCE_DIR) + "/config/paper.yaml";
@@ -116,30 +157,56 @@ int run(const Options& o) {
   } else {
     std::cout << "> note: " << paper << " not found: the 'paper' row is skipped.\n\n";
   }
+  return options;
+}
+
+void printMiddlebury(const lsf::AccuracyOptions& options) {
+  const auto t = std::chrono::steady_clock::now();
+  for (const auto& layout : lsf::runMiddleburyProtocol(options)) {
+    std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
+              << lsf::formatMiddleburyLayout(layout) << "\nPer region (mean of scenes):\n\n"
+              << lsf::formatMiddleburyRegions(layout) << "\n";
+  }
+  std::cout << "Middlebury protocol: " << secondsSince(t) << " s\n\n";
+}
+
+void printKitti(const lsf::AccuracyOptions& options) {
+  const auto t = std::chrono::steady_clock::now();
+  for (const auto& layout : lsf::runKittiProtocol(options)) {
+    std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
+              << lsf::formatKittiLayout(layout) << "\nPer depth band (mean of frames):\n\n"
+              << lsf::formatDepthBands(layout) << "\nPer region (mean of frames):\n\n"
+              << lsf::formatKittiRegions(layout) << "\n";
+  }
+  std::cout << "KITTI protocol: " << secondsSince(t) << " s"
+            << (options.kitti_pms ? "" : " (without pms)") << "\n\n";
+}
+
+void printDense(const lsf::AccuracyOptions& options) {
+  const auto t = std::chrono::steady_clock::now();
+  const lsf::DenseProtocolResult dense = lsf::runDenseProtocol(options);
+  std::cout << "## dense: " << dense.layout.description << "\n\n"
+            << lsf::formatKittiLayout(dense.layout)
+            << "\nPer depth band of the reference depth:\n\n"
+            << lsf::formatDepthBands(dense.layout) << "\nPer region:\n\n"
+            << lsf::formatKittiRegions(dense.layout) << "\nThe reference:\n\n"
+            << lsf::formatAccumulatedReference(dense.reference) << "\n";
+  std::cout << "Dense protocol: " << secondsSince(t) << " s"
+            << (options.kitti_pms ? "" : " (without pms)") << "\n";
+}
+
+int run(const Options& o) {
+  if (!std::filesystem::is_directory(o.data)) {
+    throw std::runtime_error("data folder not found: " + o.data +
+                             " (pass --data <dir> or set LSF_DATA_DIR)");
+  }
+  const lsf::AccuracyOptions options = accuracyOptions(o);
   std::cout << "Scoring: empty pixels filled like the KITTI devkit's interpolateBackground "
                "(gaps in a row take the nearer neighbour), then scored; 'raw coverage' is before "
                "the fill. Regions: see io/accuracy_protocols.h.\n\n";
-  if (o.middlebury) {
-    const auto t = std::chrono::steady_clock::now();
-    const auto layouts = lsf::runMiddleburyProtocol(options);
-    for (const auto& layout : layouts) {
-      std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
-                << lsf::formatMiddleburyLayout(layout) << "\nPer region (mean of scenes):\n\n"
-                << lsf::formatMiddleburyRegions(layout) << "\n";
-    }
-    std::cout << "Middlebury protocol: " << secondsSince(t) << " s\n\n";
-  }
-  if (o.kitti) {
-    const auto t = std::chrono::steady_clock::now();
-    const auto layouts = lsf::runKittiProtocol(options);
-    for (const auto& layout : layouts) {
-      std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
-                << lsf::formatKittiLayout(layout) << "\nPer region (mean of frames):\n\n"
-                << lsf::formatKittiRegions(layout) << "\n";
-    }
-    std::cout << "KITTI protocol: " << secondsSince(t) << " s"
-              << (o.kitti_pms ? "" : " (without pms)") << "\n";
-  }
+  if (o.middlebury) printMiddlebury(options);
+  if (o.kitti) printKitti(options);
+  if (o.dense) printDense(options);
   return 0;
 }
 

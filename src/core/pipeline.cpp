@@ -126,6 +126,7 @@ PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
   base.init_from_prior = false;
   base.use_lidar_bounds = false;
   base.coarse_scale = 1;  // Bleyer: the search runs at full size
+  base.search_scale = 1;  // and searches there (a preset's coarse-only search has no level here)
   return base;
 }
 

@@ -61,6 +61,12 @@ std::string regionName(Region region) {
       return "edge";
     case Region::kElsewhere:
       return "elsewhere";
+    case Region::kNear:
+      return "< 10 m";
+    case Region::kMid:
+      return "10-30 m";
+    case Region::kFar:
+      return ">= 30 m";
   }
   return "unknown";
 }
@@ -76,10 +82,32 @@ const cv::Mat1b& RegionMasks::mask(Region region) const {
       return edge;
     case Region::kElsewhere:
       return elsewhere;
+    case Region::kNear:
+      return near;
+    case Region::kMid:
+      return mid;
+    case Region::kFar:
+      return far;
     case Region::kAll:
       break;
   }
   return none;
+}
+
+void RegionMasks::setDepthBands(const cv::Mat1f& reference_depth) {
+  if (reference_depth.size() != above.size()) {
+    throw std::invalid_argument("RegionMasks::setDepthBands: the reference differs in size");
+  }
+  near = cv::Mat1b(reference_depth.size(), uchar(0));
+  mid = near.clone();
+  far = near.clone();
+  for (int y = 0; y < reference_depth.rows; ++y) {
+    for (int x = 0; x < reference_depth.cols; ++x) {
+      const float z = reference_depth(y, x);
+      if (!hasValue(z)) continue;
+      (z < kNearBandMax ? near : z < kFarBandMin ? mid : far)(y, x) = 255;
+    }
+  }
 }
 
 RegionMasks computeRegionMasks(const SparseDisparity& fed, const cv::Mat& image,
@@ -112,6 +140,9 @@ RegionMasks computeRegionMasks(const SparseDisparity& fed, const cv::Mat& image,
     }
   }
   masks.elsewhere = masks.inside - masks.edge;
+  masks.near = cv::Mat1b(rows, cols, uchar(0));
+  masks.mid = masks.near.clone();
+  masks.far = masks.near.clone();
   return masks;
 }
 

@@ -1,6 +1,7 @@
 // The accuracy protocols' helpers on hand-made maps with exact answers: nearest-LiDAR fill, map
 // combination, region masks, layouts.
 #include <algorithm>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -101,6 +102,29 @@ TEST(RegionMasks, LinesWithinThreePixelsMakeNoEdge) {
                std::invalid_argument);
 }
 
+TEST(RegionMasks, DepthBandsSplitTheReferenceAtTenAndThirtyMetres) {
+  RegionMasks m = computeRegionMasks(twoLines(10.f, 13.f), cv::Mat(9, 4, CV_8UC1, 0.0));
+  EXPECT_EQ(cv::countNonZero(m.near) + cv::countNonZero(m.mid) + cv::countNonZero(m.far), 0);
+  cv::Mat1f reference(9, 4, 0.f);
+  reference(0, 0) = 9.999f;
+  reference(0, 1) = 10.f;  // 10 m is in 10-30
+  reference(0, 2) = 29.99f;
+  reference(0, 3) = 30.f;                                     // 30 m is in >= 30
+  reference(8, 3) = std::numeric_limits<float>::quiet_NaN();  // no reference
+  m.setDepthBands(reference);
+  EXPECT_EQ(cv::countNonZero(m.near), 1);
+  EXPECT_EQ(m.near(0, 0), 255);
+  EXPECT_EQ(cv::countNonZero(m.mid), 2);
+  EXPECT_EQ(m.mid(0, 1), 255);
+  EXPECT_EQ(m.mid(0, 2), 255);
+  EXPECT_EQ(cv::countNonZero(m.far), 1);
+  EXPECT_EQ(m.far(0, 3), 255);
+  EXPECT_EQ(&m.mask(Region::kMid), &m.mid);
+  EXPECT_EQ(regionName(Region::kNear), "< 10 m");
+  EXPECT_EQ(regionName(Region::kFar), ">= 30 m");
+  EXPECT_THROW(m.setDepthBands(cv::Mat1f(8, 4, 0.f)), std::invalid_argument);
+}
+
 TEST(AccuracyLayouts, MiddleburyRowsAndKittiKeepEvery) {
   const cv::Mat1f gt(90, 5, 4.f);
   EXPECT_EQ(cv::countNonZero(middleburyLayout(gt, "mb64").disparity), 64 * 5);
@@ -113,9 +137,16 @@ TEST(AccuracyLayouts, MiddleburyRowsAndKittiKeepEvery) {
   EXPECT_THROW(middleburyLayout(gt, "mb8"), std::invalid_argument);
   EXPECT_THROW(kittiKeepEvery("ring8"), std::invalid_argument);
   AccuracyOptions options;
-  options.methods = {"fused", "nearest"};
+  options.methods = {"fused", "nearest", "ip_basic"};
+  options.layouts = {"ring32", "dense"};
   EXPECT_NO_THROW(options.validate());
+  options.layouts = {"dense64"};
+  EXPECT_THROW(options.validate(), std::invalid_argument);
+  options.layouts.clear();
   options.methods = {"fast"};
+  EXPECT_THROW(options.validate(), std::invalid_argument);
+  options.methods.clear();
+  options.ip_basic.dilation_kernel = 4;
   EXPECT_THROW(options.validate(), std::invalid_argument);
 }
 

@@ -8,6 +8,8 @@
 //  * KITTI raw drive 0009 ring hold-out (makeRingHoldout): "ring32" feeds rings with ring % 2 == 0,
 //    "ring16" rings with ring % 4 == 0; all other rings' points are the reference depth. Scored
 //    with evaluateDepth; mean over frames (averageMetrics).
+//  * KITTI raw drive 0009 dense LiDAR (io/accuracy_dense.h): "dense" feeds frame 20's full sweep
+//    and scores against the depth accumulated from sweeps 15-25 (io/kitti_accumulated.h).
 //
 // Scoring rule for every method: empty pixels are first filled by fillLikeDevkit (the KITTI
 // devkit's interpolateBackground), as the KITTI benchmark does; "raw coverage" reports the fraction
@@ -15,8 +17,10 @@
 //
 // Methods (rows): "fused" (FusionParams() defaults), "paper" (the preset, when given), "lidar_bi",
 // "lidar_bf", "pms" (all through FusionPipeline), "lidar_bi else pms" (lidar_bi where it has a
-// value, pms elsewhere) and "nearest" (every pixel takes the disparity of the nearest fed LiDAR
-// pixel, exact 2-D Euclidean distance; needs no fill).
+// value, pms elsewhere), "nearest" (every pixel takes the disparity of the nearest fed LiDAR
+// pixel, exact 2-D Euclidean distance; needs no fill) and "ip_basic" (core/ip_basic.h on the fed
+// sparse depth; on Middlebury the disparity is turned into depth and back with the protocol's
+// camera, fx B = 100 px m, so that the quarter-size disparities 5-64 px are 1.6-20 m).
 //
 // Regions (each scored separately over the reference pixels inside it), from the fed sparse
 // disparity of the left view:
@@ -29,6 +33,8 @@
 //               removeOccludedPoints), and the difference is computeScanLineBounds(lines, 0).range
 //               = |d_up - d_down| [px];
 //  * "elsewhere": inside and not edge.
+// Depth bands (KITTI protocols; empty on Middlebury), by the reference depth z [m]: "< 10 m"
+// (z < 10), "10-30 m" (10 <= z < 30), ">= 30 m" (z >= 30).
 #pragma once
 
 #include <array>
@@ -40,24 +46,33 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidar_stereo_fusion/core/ip_basic.h"
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/metrics.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
 
 namespace lidar_stereo_fusion {
 
-enum class Region { kAll, kAbove, kInside, kEdge, kElsewhere };
-constexpr int kRegionCount = 5;
-/// "all", "above", "inside", "edge", "elsewhere".
+enum class Region { kAll, kAbove, kInside, kEdge, kElsewhere, kNear, kMid, kFar };
+constexpr int kRegionCount = 8;
+/// The depth bands' limits [m] (kNear: z < kNearBandMax, kFar: z >= kFarBandMin).
+constexpr double kNearBandMax = 10.0;
+constexpr double kFarBandMin = 30.0;
+/// "all", "above", "inside", "edge", "elsewhere", "< 10 m", "10-30 m", ">= 30 m".
 std::string regionName(Region region);
 
 /// Region masks of one image (CV_8U, 255 inside the region); see the file comment.
 struct RegionMasks {
   cv::Mat1b above, inside, edge, elsewhere;
+  cv::Mat1b near, mid, far;                    ///< depth bands; all 0 until setDepthBands
   const cv::Mat1b& mask(Region region) const;  ///< empty Mat for kAll
+  /// Sets the depth bands from a reference depth map [m] (0 / NaN = no reference) of the masks'
+  /// size. Throws std::invalid_argument on a size mismatch.
+  void setDepthBands(const cv::Mat1f& reference_depth);
 };
 
-/// Masks from the fed left-view sparse disparity and the left image (BGR or grey, same size).
+/// Masks from the fed left-view sparse disparity and the left image (BGR or grey, same size); the
+/// depth bands all 0.
 /// `edge_range_px` is the scan-line disagreement [px] above which a pixel is "edge" (3 px).
 /// Throws std::invalid_argument on an empty map or a size mismatch.
 RegionMasks computeRegionMasks(const SparseDisparity& fed, const cv::Mat& image,
@@ -91,7 +106,7 @@ struct MethodScores {
 /// One layout (a pseudo-LiDAR of a given density, a ring subset) of one protocol.
 template <typename Metrics>
 struct LayoutScores {
-  std::string name;                ///< "mb64", "mb16", "mb42low", "ring32", "ring16"
+  std::string name;                ///< "mb64", "mb16", "mb42low", "ring32", "ring16", "dense"
   std::string description;         ///< one line for the table title
   std::vector<std::string> items;  ///< scene or frame names
   std::vector<MethodScores<Metrics>> methods;
@@ -111,11 +126,12 @@ struct AccuracyOptions {
   std::string data_dir;               ///< the folder of ../shared/data
   FusionParams fused;                 ///< the "fused" row (and the base of lidar_*, pms)
   std::optional<FusionParams> paper;  ///< the "paper" row; absent: the row is skipped
+  IpBasicParams ip_basic;             ///< the "ip_basic" row
   /// Method rows to run (names as above); empty = all. "lidar_bi else pms" needs both parts.
   std::set<std::string> methods;
-  std::set<std::string> layouts;     ///< layout names to run; empty = all
-  int kitti_frames = 0;              ///< the first N frames; 0 = all
-  bool kitti_pms = true;             ///< false: skip pms and "lidar_bi else pms" on KITTI
+  std::set<std::string> layouts;  ///< layout names to run; empty = all
+  int kitti_frames = 0;           ///< the first N frames; 0 = all
+  bool kitti_pms = true;  ///< false: skip pms and "lidar_bi else pms" on KITTI (ring and dense)
   std::ostream* progress = nullptr;  ///< one line per scene / frame when set
   /// Throws std::invalid_argument for an unknown method / layout name or kitti_frames < 0.
   void validate() const;
@@ -125,6 +141,7 @@ struct AccuracyOptions {
 std::vector<std::string> accuracyMethodNames();
 std::vector<std::string> middleburyLayoutNames();
 std::vector<std::string> kittiLayoutNames();
+std::vector<std::string> denseLayoutNames();
 
 /// Middlebury pseudo-LiDAR of a layout ("mb64", "mb16", "mb42low") for a ground-truth map [px].
 /// Throws std::invalid_argument for an unknown layout.

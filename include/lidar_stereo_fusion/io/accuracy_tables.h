@@ -5,16 +5,18 @@
 #include <vector>
 
 #include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/io/kitti_accumulated.h"
 
 namespace lidar_stereo_fusion {
 
 /// Main table of a Middlebury layout: one row per method (mean of the scenes, region "all"), the
-/// columns of formatDisparityTable plus raw coverage [%] (before the devkit fill) and time [s].
+/// columns of formatDisparityTable plus raw coverage [%] (before the devkit fill) and the wall
+/// time per scene [ms].
 /// Then a per-scene table: MAE [px] and bad-2 [%] per scene.
 std::string formatMiddleburyLayout(const LayoutScores<DisparityMetrics>& layout);
 
 /// Main table of a KITTI layout: one row per method (mean over frames, region "all"), the columns
-/// of formatDepthTable plus raw coverage [%] and time [s].
+/// of formatDepthTable plus raw coverage [%] and the wall time per frame [ms].
 std::string formatKittiLayout(const LayoutScores<DepthMetrics>& layout);
 
 /// Per-region table: rows = methods, for each region (above, inside, edge, elsewhere) MAE [px]
@@ -22,5 +24,13 @@ std::string formatKittiLayout(const LayoutScores<DepthMetrics>& layout);
 /// share of the reference pixels [%].
 std::string formatMiddleburyRegions(const LayoutScores<DisparityMetrics>& layout);
 std::string formatKittiRegions(const LayoutScores<DepthMetrics>& layout);
+
+/// Depth-band table of a KITTI layout: rows = methods, MAE [mm] and RMSE [mm] over all reference
+/// pixels and in the bands < 10 m, 10-30 m, >= 30 m of the reference depth; a last row gives each
+/// band's share of the reference pixels [%].
+std::string formatDepthBands(const LayoutScores<DepthMetrics>& layout);
+
+/// How an accumulated reference was built (io/kitti_accumulated.h), as a two-column table.
+std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference);
 
 }  // namespace lidar_stereo_fusion

@@ -1,0 +1,32 @@
+// The dense-LiDAR accuracy protocol: KITTI raw drive 0009, frame 20, the full sweep (64 rings,
+// rings recovered from the sweep order as kitti::loadFrame does) fed to every method, scored
+// against the depth accumulated from sweeps 15-25 (io/kitti_accumulated.h: OXTS poses, points
+// that disagree with frame 20's own sweep removed, frame 20's own sweep included, as in KITTI's
+// depth-completion ground truth). Empty pixels are filled like the devkit (fillLikeDevkit) before
+// scoring, as in the other protocols. Regions as io/accuracy_protocols.h (above / inside / edge /
+// elsewhere from the fed projection) plus the depth bands < 10 m, 10-30 m, >= 30 m of the
+// reference depth. ROS-free.
+#pragma once
+
+#include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/io/kitti_accumulated.h"
+
+namespace lidar_stereo_fusion {
+
+/// The frame of the dense protocol (the drive's frame with 5 sweeps and OXTS packets each side).
+constexpr const char* kDenseFrame = "0000000020";
+
+/// The layout "dense" and how its reference was built.
+struct DenseProtocolResult {
+  LayoutScores<DepthMetrics> layout;
+  kitti::AccumulatedDepth reference;
+};
+
+/// Runs the dense protocol on data_dir/kitti_raw/2011_09_26/2011_09_26_drive_0009_sync (every
+/// wanted row; pms and "lidar_bi else pms" only when options.kitti_pms). Throws
+/// std::runtime_error naming what is missing (the drive, a sweep, an OXTS packet, the frame's
+/// images).
+DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
+                                     const kitti::AccumulationParams& reference_params = {});
+
+}  // namespace lidar_stereo_fusion

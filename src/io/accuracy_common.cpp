@@ -1,0 +1,134 @@
+// Scoring, rows and one KITTI case of the accuracy protocols.
+#include "accuracy_common.h"
+
+#include <cmath>
+
+#include "lidar_stereo_fusion/core/depth.h"
+
+namespace lidar_stereo_fusion {
+namespace accuracy_detail {
+namespace {
+
+/// The reference restricted to a region (0 outside it).
+cv::Mat1f maskReference(const cv::Mat1f& reference, const cv::Mat1b& mask) {
+  if (mask.empty()) return reference;
+  cv::Mat1f out(reference.size(), 0.f);
+  reference.copyTo(out, mask);
+  return out;
+}
+
+}  // namespace
+
+const char* const kLidarElsePms = "lidar_bi else pms";
+const char* const kNearest = "nearest";
+const char* const kIpBasic = "ip_basic";
+
+double secondsSince(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+double rawCoverage(const cv::Mat1f& estimate, const cv::Mat1f& reference) {
+  long covered = 0, total = 0;
+  for (int y = 0; y < reference.rows; ++y) {
+    for (int x = 0; x < reference.cols; ++x) {
+      if (!(reference(y, x) > 0.f)) continue;
+      ++total;
+      covered += std::isfinite(estimate(y, x)) && estimate(y, x) > 0.f;
+    }
+  }
+  return total > 0 ? static_cast<double>(covered) / total : 0.0;
+}
+
+RegionScores<DisparityMetrics> scoreRegions(const cv::Mat1f& disparity, const cv::Mat1f& reference,
+                                            const RegionMasks& masks) {
+  const cv::Mat1f filled = fillLikeDevkit(disparity, MapKind::kDisparity);
+  RegionScores<DisparityMetrics> scores;
+  for (int r = 0; r < kRegionCount; ++r) {
+    scores[r] = evaluateDisparity(filled, maskReference(reference, masks.mask(Region(r))));
+  }
+  return scores;
+}
+
+RegionScores<DepthMetrics> scoreRegions(const cv::Mat1f& depth, const cv::Mat1f& reference,
+                                        const RegionMasks& masks, const StereoCamera& camera) {
+  const cv::Mat1f filled = fillLikeDevkit(depth, MapKind::kDepth);
+  RegionScores<DepthMetrics> scores;
+  for (int r = 0; r < kRegionCount; ++r) {
+    scores[r] = evaluateDepth(filled, maskReference(reference, masks.mask(Region(r))), camera);
+  }
+  return scores;
+}
+
+cv::Mat1f ipBasicOnDisparity(const cv::Mat1f& disparity, const StereoCamera& camera,
+                             const IpBasicParams& params) {
+  return depthToDisparity(ipBasicFill(disparityToDepth(disparity, camera), params), camera);
+}
+
+bool wantedRow(const AccuracyOptions& options, const std::string& name) {
+  return options.methods.empty() || options.methods.count(name) > 0;
+}
+
+bool wantedLayout(const AccuracyOptions& options, const std::string& name) {
+  return options.layouts.empty() || options.layouts.count(name) > 0;
+}
+
+std::vector<std::pair<std::string, FusionParams>> pipelineRows(const AccuracyOptions& options,
+                                                               bool with_pms) {
+  std::vector<std::pair<std::string, FusionParams>> rows;
+  if (wantedRow(options, "fused")) rows.emplace_back("fused", options.fused);
+  if (wantedRow(options, "paper") && options.paper) rows.emplace_back("paper", *options.paper);
+  for (Method m : {Method::kLidarBI, Method::kLidarBF, Method::kPlainPMS}) {
+    const std::string name = methodName(m);
+    const bool needed_for_combination = wantedRow(options, kLidarElsePms) && name != "lidar_bf";
+    if (m == Method::kPlainPMS && !with_pms) continue;
+    if (!wantedRow(options, name) && !needed_for_combination) continue;
+    FusionParams params = options.fused;
+    params.method = m;
+    rows.emplace_back(name, params);
+  }
+  return rows;
+}
+
+void scoreDepthCase(const DepthCase& c, const AccuracyOptions& options,
+                    const std::vector<std::pair<std::string, FusionParams>>& rows, PmsRun& pms,
+                    LayoutAccumulator<DepthMetrics>& acc) {
+  const StereoCamera& camera = c.calib.camera;
+  const FusionInput input{c.frame.left, c.frame.right, c.fed, c.calib.T_cam_velo, camera};
+  const SparseDisparity fed =
+      projectCloud(c.fed, c.calib.T_cam_velo, camera, options.fused.projection, View::kLeft);
+  RegionMasks masks = computeRegionMasks(fed, c.frame.left);
+  masks.setDepthBands(c.reference);
+  const auto add = [&](const std::string& name, const cv::Mat1f& depth, double seconds) {
+    acc.add(name, scoreRegions(depth, c.reference, masks, camera), rawCoverage(depth, c.reference),
+            seconds);
+  };
+  std::map<std::string, cv::Mat1f> depth;
+  for (const auto& [name, params] : rows) {
+    const auto t = Clock::now();
+    if (name == "pms" && !pms.depth.empty()) {
+      depth[name] = pms.depth;  // the shared run's time, in every layout (as on Middlebury)
+    } else {
+      FusionPipeline pipeline(params);
+      depth[name] = pipeline.process(input).depth;
+      if (name == "pms") pms = {depth[name], secondsSince(t)};
+    }
+    if (wantedRow(options, name))
+      add(name, depth[name], name == "pms" ? pms.seconds : secondsSince(t));
+  }
+  if (depth.count("pms") > 0 && wantedRow(options, kLidarElsePms)) {
+    add(kLidarElsePms, combineMaps(depth.at("lidar_bi"), depth.at("pms")), 0.0);
+  }
+  if (wantedRow(options, kNearest)) {
+    const auto t = Clock::now();
+    const cv::Mat1f nearest = disparityToDepth(nearestFill(fed.disparity), camera);
+    add(kNearest, nearest, secondsSince(t));
+  }
+  if (wantedRow(options, kIpBasic)) {
+    const auto t = Clock::now();
+    const cv::Mat1f filled = ipBasicFill(disparityToDepth(fed.disparity, camera), options.ip_basic);
+    add(kIpBasic, filled, secondsSince(t));
+  }
+}
+
+}  // namespace accuracy_detail
+}  // namespace lidar_stereo_fusion

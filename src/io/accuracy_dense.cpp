@@ -1,0 +1,58 @@
+// The dense-LiDAR protocol: frame 20's full sweep in, the accumulated reference out.
+#include "lidar_stereo_fusion/io/accuracy_dense.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <ostream>
+#include <set>
+#include <stdexcept>
+
+#include "accuracy_common.h"
+
+namespace lidar_stereo_fusion {
+
+DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
+                                     const kitti::AccumulationParams& reference_params) {
+  using namespace accuracy_detail;
+  options.validate();
+  const std::string drive =
+      (std::filesystem::path(options.data_dir) / "kitti_raw/2011_09_26/2011_09_26_drive_0009_sync")
+          .string();
+  if (!std::filesystem::is_directory(drive)) {
+    throw std::runtime_error("KITTI drive not found: " + drive);
+  }
+  const kitti::Calibration calib = kitti::readCalibration(kitti::calibrationDirOf(drive));
+  const std::vector<kitti::Frame> frames = kitti::listFrames(drive);
+  const auto frame = std::find_if(frames.begin(), frames.end(),
+                                  [](const kitti::Frame& f) { return f.name == kDenseFrame; });
+  if (frame == frames.end()) {
+    throw std::runtime_error(std::string("KITTI: frame ") + kDenseFrame +
+                             " (images and sweep) of " + drive + " not found");
+  }
+  if (options.progress) *options.progress << "KITTI dense, frame " << frame->name << std::endl;
+  DenseProtocolResult out;
+  out.reference = kitti::buildAccumulatedReference(drive, kDenseFrame, calib, reference_params);
+  const kitti::FrameData data = kitti::loadFrame(*frame, calib.camera);
+  LayoutScores<DepthMetrics>& layout = out.layout;
+  layout.name = "dense";
+  layout.items.push_back(frame->name);
+  std::set<int> rings;
+  for (const LidarPoint& p : data.cloud) rings.insert(p.ring);
+  layout.fed_rings.push_back(static_cast<int>(rings.size()));
+  LayoutAccumulator<DepthMetrics> acc;
+  PmsRun pms;
+  scoreDepthCase({data, data.cloud, out.reference.depth, calib}, options,
+                 pipelineRows(options, options.kitti_pms), pms, acc);
+  layout.methods = acc.finish();
+  const long center = static_cast<long>(kitti::frameIndex(kDenseFrame));
+  layout.description = "KITTI drive 0009 frame " + std::to_string(center) + ", the full sweep (" +
+                       std::to_string(rings.size()) +
+                       " rings) fed, scored against the depth accumulated from sweeps " +
+                       std::to_string(center - reference_params.half_span) + "-" +
+                       std::to_string(center + reference_params.half_span) + " (" +
+                       std::to_string(out.reference.pixels) +
+                       " pixels, the frame's own sweep included)";
+  return out;
+}
+
+}  // namespace lidar_stereo_fusion
