@@ -126,8 +126,7 @@ bool compensateEgoMotion(const InputMatch& match, const NodeParams& params, cons
       return false;
     }
     frame.notes.push_back(
-        {"egomotion",
-         failed + "; frame processed uncompensated (~motion_failure: uncompensated)"});
+        {"egomotion", failed + "; frame processed uncompensated (~motion_failure: uncompensated)"});
   }
   frame.report.motion_ms = msSince(start);
   return true;

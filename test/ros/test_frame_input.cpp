@@ -21,7 +21,7 @@ namespace conv = lidar_stereo_fusion::conversions;
 namespace {
 
 constexpr int kWidth = 64, kHeight = 48;
-constexpr int kSeed = 7;  ///< of the image texture
+constexpr int kSeed = 7;                                          ///< of the image texture
 const ros::Time kImageStamp(100, 0), kSweepStamp(100, 20000000);  // sweep 20 ms after the images
 
 sensor_msgs::ImagePtr imageMsg(const cv::Mat& bgr, const std::string& frame) {
@@ -242,8 +242,9 @@ TEST(FramePath, MissingEgoMotionSkipsOrGoesOnUncompensatedAsConfigured) {
   lsf::PreparedFrame frame = prepare(goodMatch(), params, tf);
   EXPECT_EQ(frame.rejection, lsf::FrameRejection::kNoEgoMotion);
   EXPECT_STREQ(lsf::rejectionKind(frame.rejection), "egomotion");
-  EXPECT_TRUE(contains(frame.reason, "ego-motion compensation of the sweep at 100.020000 to the "
-                                     "images at 100.000000 failed: "))
+  EXPECT_TRUE(contains(frame.reason,
+                       "ego-motion compensation of the sweep at 100.020000 to the "
+                       "images at 100.000000 failed: "))
       << frame.reason;
   EXPECT_TRUE(contains(frame.reason, "(~motion_failure: skip)")) << frame.reason;
   EXPECT_NE(frame.report.motion_failure, "");
@@ -263,7 +264,8 @@ TEST(FramePath, EgoMotionWaitsOnceForTheLatestInstantThenCompensates) {
   // A rig standing still in odom from 99 s to 101 s.
   tf2::BufferCore buffer;
   for (const double t : {99.0, 101.0}) {
-    geometry_msgs::TransformStamped odom_lidar = tf2::eigenToTransform(Eigen::Isometry3d::Identity());
+    geometry_msgs::TransformStamped odom_lidar =
+        tf2::eigenToTransform(Eigen::Isometry3d::Identity());
     odom_lidar.header.frame_id = "odom";
     odom_lidar.header.stamp = ros::Time(t);
     odom_lidar.child_frame_id = "velodyne";
