@@ -2,7 +2,8 @@
 # executable, plus the install rules of launch, config and rviz files. Included after the core
 # targets, with catkin set up by cmake/ros_catkin.cmake.
 #
-#   lidar_stereo_fusion_ros   conversions, parameters, the worker and the nodelet plugin
+#   lidar_stereo_fusion_ros   conversions, parameters, the frame path, the worker and the nodelet
+#                             plugin
 #   fusion_node               loads lidar_stereo_fusion/FusionNodelet with nodelet::Loader
 
 set(LSF_ROS_INCLUDE_DIRS
@@ -20,6 +21,7 @@ add_library(${PROJECT_NAME}_ros
   src/ros/stereo_sync.cpp
   src/ros/input_gate.cpp
   src/ros/input_watch.cpp
+  src/ros/frame_input.cpp
   src/ros/output_publisher.cpp
   src/ros/fusion_worker.cpp
   src/ros/fusion_nodelet.cpp)

@@ -1,8 +1,9 @@
 # Tests of the ROS layer (nodelet, node, launch files, RViz config). Included after the core tests
 # when testing is enabled, with catkin set up and the ROS targets defined.
 #
-#   test_ros_unit            conversions, sweep matching, parameter mapping, launch arguments,
-#                            what PCL's cloud conversion does not check (no ROS master)
+#   test_ros_unit            conversions, sweep matching, the frame path, parameter mapping,
+#                            launch arguments, what PCL's cloud conversion does not check (no
+#                            ROS master)
 #   fusion_nodelet.test      rostest of the nodelet (test_fusion_node: synthetic input, bad input,
 #   fusion_node.test           lazy subscription, TF, live parameters, diagnostics); the same test
 #   fusion_approx_sync.test    source against the node, and with approximate sync
@@ -19,6 +20,7 @@ set(LSF_ROS_TEST_DEFINITIONS
 
 catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp test/ros/test_ros_params.cpp
   test/ros/test_frame_matcher.cpp
+  test/ros/test_frame_input.cpp
   test/ros/test_input_attacks.cpp
   test/ros/test_point_time.cpp
   test/ros/test_node_parts.cpp test/ros/test_launch_files.cpp test/ros/run_command.cpp

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -138,6 +139,30 @@ cv::Mat withColorBar(const cv::Mat& picture, double value_at_0, double value_at_
                 cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar::all(230), 1, cv::LINE_AA);
   }
   return out;
+}
+
+double disparityColorScale(const cv::Mat1f& disparity, double max_search) {
+  std::vector<float> values;
+  values.reserve(disparity.total());
+  for (const float d : disparity) {
+    if (d > 0.f) values.push_back(d);
+  }
+  double top = 16.0;
+  if (!values.empty()) {
+    auto at = values.begin() + static_cast<std::ptrdiff_t>(0.99 * (values.size() - 1));
+    std::nth_element(values.begin(), at, values.end());
+    top = 16.0 * std::max(1.0, std::ceil(*at / 16.0));
+  }
+  return std::min(max_search, top);
+}
+
+cv::Mat disparityPicture(const cv::Mat1f& disparity, double max_search) {
+  const double max = disparityColorScale(disparity, max_search);
+  return withColorBar(colorizeDisparity(disparity, max), 0.0, max, "px");
+}
+
+cv::Mat depthPicture(const cv::Mat1f& depth, double max_depth) {
+  return withColorBar(colorizeDepth(depth, max_depth), max_depth, 0.0, "m");
 }
 
 cv::Mat overlaySparse(const cv::Mat& image, const cv::Mat1f& sparse, double max_disparity) {

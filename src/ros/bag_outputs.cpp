@@ -3,20 +3,18 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
-#include <tf2/exceptions.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "lidar_stereo_fusion/core/depth.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/pcd.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
-#include "lidar_stereo_fusion/ros/ego_motion.h"
+#include "lidar_stereo_fusion/ros/frame_input.h"
 #include "lidar_stereo_fusion/ros/output_publisher.h"
 
 namespace fs = std::filesystem;
@@ -24,11 +22,6 @@ namespace fs = std::filesystem;
 namespace lidar_stereo_fusion {
 
 namespace {
-
-double msSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 std::string format(const char* fmt, double v) {
   char text[64];
@@ -74,51 +67,19 @@ cv::Mat scaledUint16(const cv::Mat1f& image, double scale) {
 FusedSet fuseSet(const InputMatch& match, const Eigen::Isometry3d& T_cam_lidar,
                  FusionPipeline& pipeline, const NodeParams& node_params,
                  const tf2::BufferCore& tf) {
-  // As FusionWorker::processMatch: the same conversions, ring recovery and pipeline.
-  const ImageSet& images = match.images;
+  EgoMotionTf ego_motion;
+  ego_motion.buffer = &tf;  // the bag's: no wait
+  PreparedFrame frame = prepareFusionInput(match, T_cam_lidar, node_params, ego_motion, "");
+  if (!frame.accepted()) throw std::runtime_error(frame.reason);
   FusedSet out;
-  FusionInput input;
-  input.T_cam_lidar = T_cam_lidar;
-  const auto start = std::chrono::steady_clock::now();
-  conversions::CloudConversion cloud;
   try {
-    conversions::stereoPairToCore(images.left, images.right, input.left, input.right);
-    input.camera = conversions::stereoCameraFromInfo(*images.left_info, *images.right_info);
-    cloud = conversions::cloudFromMsg(*match.sweep, node_params.max_point_time);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(std::string("cannot convert the input set: ") + e.what());
-  }
-  if (cloud.cloud.empty()) {
-    throw std::runtime_error("none of the " + std::to_string(cloud.total_points) +
-                             " points of the sweep at " + stampName(match.sweep_stamp) +
-                             " is finite and within 10 km");
-  }
-  out.rings = ensureRings(cloud.cloud, cloud.has_ring, node_params.num_rings);
-  if (!node_params.fixed_frame.empty()) {  // as FusionWorker::compensateEgoMotion
-    try {
-      compensateSweep(tf, match.sweep->header.frame_id, node_params.fixed_frame, match.sweep_stamp,
-                      match.image_stamp,
-                      motionSampleTimes(cloud.cloud, cloud.has_time, node_params.motion_samples),
-                      input.T_cam_lidar, input.camera, cloud.cloud);
-      out.motion_compensated = true;
-    } catch (const tf2::TransformException& e) {
-      if (node_params.motion_failure == "skip") {
-        throw std::runtime_error(std::string(e.what()) + " (~motion_failure: skip)");
-      }
-      out.motion_failure = e.what();
-    }
-  }
-  input.cloud = std::move(cloud.cloud);
-  out.cloud_points = static_cast<int>(input.cloud.size());
-  out.invalid_points = cloud.non_finite + cloud.implausible;
-  out.conversion_ms = msSince(start);
-  try {
-    out.result = pipeline.process(input);
+    out.result = pipeline.process(frame.input);
   } catch (const std::exception& e) {
     throw std::runtime_error(std::string("fusion failed: ") + e.what());
   }
-  out.camera = input.camera;
-  out.left = input.left;
+  out.report = std::move(frame.report);
+  out.camera = frame.input.camera;
+  out.left = frame.input.left;
   out.depth = outputDepth(out.result, out.camera, node_params.max_output_depth);
   return out;
 }
@@ -134,12 +95,12 @@ std::string okRow(const ros::Time& stamp, const InputMatch& match, const FusedSe
   const FrameStats& s = set.result.stats;
   return stampName(stamp) + ",ok,," + stampName(match.sweep_stamp) + "," +
          format("%.6f", (match.sweep_stamp - match.image_stamp).toSec()) + "," +
-         format("%.1f", set.conversion_ms) + "," + format("%.1f", s.projection_ms) + "," +
+         format("%.1f", set.report.conversion_ms) + "," + format("%.1f", s.projection_ms) + "," +
          format("%.1f", s.upsampling_ms) + "," + format("%.1f", s.patchmatch_ms) + "," +
          format("%.1f", s.depth_ms) + "," + format("%.1f", s.total_ms) + "," +
-         std::to_string(set.cloud_points) + "," + format("%.4f", s.prior_coverage) + "," +
-         format("%.4f", s.output_coverage) + "," + std::to_string(set.rings.rings) + "," +
-         ringSourceName(set.rings.source) + "," + method + "\n";
+         std::to_string(set.report.cloud_points) + "," + format("%.4f", s.prior_coverage) + "," +
+         format("%.4f", s.output_coverage) + "," + std::to_string(set.report.rings.rings) + "," +
+         ringSourceName(set.report.rings.source) + "," + method + "\n";
 }
 
 std::string notOkRow(const ros::Time& stamp, const std::string& status, const std::string& reason) {

@@ -263,10 +263,10 @@ void Runner::finishSet(lsf::SetOutcome& s, lsf::FusionPipeline& pipeline,
                                lsf::stampName(at) + " in /tf_static or /tf: " + e.what());
     }
     const lsf::FusedSet set = lsf::fuseSet(match, T, pipeline, node_params_, pairing_->tf());
-    if (!set.motion_failure.empty()) {
+    if (!set.report.motion_failure.empty()) {
       std::cerr << "\nbag_runner: warning: image set " << name
                 << " processed without ego-motion compensation (~motion_failure: uncompensated): "
-                << set.motion_failure << "\n";
+                << set.report.motion_failure << "\n";
     }
     writer.write(match, s.receipt, set, params_);
     rows_[s.stamp] = lsf::okRow(s.stamp, match, set, lsf::methodName(params_.method));

@@ -4,19 +4,15 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
-#include <utility>
 #include <vector>
 
 #include <tf2_eigen/tf2_eigen.h>
 #include <boost/bind/bind.hpp>
 
-#include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
-#include "lidar_stereo_fusion/ros/conversions.h"
 #include "lidar_stereo_fusion/ros/ego_motion.h"
 #include "lidar_stereo_fusion/ros/ros_params.h"
 
@@ -30,11 +26,6 @@ NodeParams readNodeParamsLogged(const ros::NodeHandle& pnh, const std::string& n
   NodeParams p = ros_params::readNodeParams(pnh, &errors);
   for (const auto& e : errors) ROS_ERROR_STREAM("[" << name << "] " << e);
   return p;
-}
-
-double msSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
 }
 
 }  // namespace
@@ -176,95 +167,19 @@ void FusionWorker::workerLoop() {
 }
 
 void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipeline) {
-  const ImageSet& set = match.images;
-  const sensor_msgs::PointCloud2& cloud_msg = *match.sweep;
-  const std::string& camera_frame = set.left->header.frame_id;
-  const std::string& lidar_frame = cloud_msg.header.frame_id;
-
-  // Extrinsics at the sweep stamp, or at the image stamp the points are moved to with
-  // ~fixed_frame; a short timeout bounds the wait (worker thread only).
-  const ros::Time extrinsics_stamp =
-      extrinsicsStamp(frame_node_.fixed_frame, match.sweep_stamp, match.image_stamp);
-  FusionInput input;
-  try {
-    const geometry_msgs::TransformStamped tf = tf_buffer_.lookupTransform(
-        camera_frame, lidar_frame, extrinsics_stamp, ros::Duration(frame_node_.tf_timeout));
-    input.T_cam_lidar = tf2::transformToEigen(tf);
-  } catch (const tf2::TransformException& e) {
-    ++counters_.tf_failures;
-    log_.warn(kCloud, "tf",
-              "no transform from '" + lidar_frame + "' (" + topicName(kCloud) + ") to '" +
-                  camera_frame + "' (" + topicName(kLeftImage) + ") at " +
-                  (frame_node_.fixed_frame.empty() ? "sweep stamp " : "image stamp ") +
-                  stampText(extrinsics_stamp) + " within " +
-                  std::to_string(frame_node_.tf_timeout) + " s: " + e.what() + "; frame skipped");
-    return;
-  }
-
-  const auto conversion_start = std::chrono::steady_clock::now();
-  conversions::CloudConversion cloud;
-  std::string pair_note;
-  try {
-    conversions::stereoPairToCore(set.left, set.right, input.left, input.right, &pair_note);
-    input.camera = conversions::stereoCameraFromInfo(*set.left_info, *set.right_info);
-    cloud = conversions::cloudFromMsg(cloud_msg, frame_node_.max_point_time);
-  } catch (const std::exception& e) {  // ConversionError, and anything OpenCV lets through
-    ++counters_.invalid;
-    log_.warn("input set", "convert",
-              "cannot convert the input set at " + stampText(match.image_stamp) + ": " + e.what() +
-                  "; frame skipped");
-    return;
-  }
-  if (!pair_note.empty() &&
-      pair_note != mixed_encodings_said_) {  // said once per pair of encodings
-    ROS_WARN_STREAM("[" << name_ << "] " << pair_note);
-    mixed_encodings_said_ = pair_note;
-  }
-  if (cloud.cloud.empty()) {
-    ++counters_.invalid;
-    log_.warn(kCloud, "nan",
-              topicName(kCloud) + ": none of the " + std::to_string(cloud.total_points) +
-                  " points of the sweep at " + stampText(match.sweep_stamp) +
-                  " is finite and within 10 km (" + std::to_string(cloud.non_finite) +
-                  " NaN / inf, " + std::to_string(cloud.implausible) +
-                  " beyond 10 km); frame skipped");
-    return;
-  }
-  FrameReport report;
-  // The ring field if plausible, else the offline sweep-order rule, else elevation; each checked.
-  report.rings = ensureRings(cloud.cloud, cloud.has_ring, frame_node_.num_rings);
-  if (!report.rings.plausible) {
-    log_.warn(kCloud, "rings",
-              topicName(kCloud) + ": no plausible scan lines in the sweep at " +
-                  stampText(match.sweep_stamp) + " (" + report.rings.fallbacks + "); using " +
-                  std::to_string(report.rings.rings) + " rings by " +
-                  ringSourceName(report.rings.source) +
-                  ", the prior will be coarse (publish the driver's ring field, or set "
-                  "~num_rings to the sensor's beam count)");
-  }
-  report.point_time_field = conversions::pointTimeFieldName(cloud.time_field);
-  report.bad_times = cloud.bad_times;
-  if (cloud.bad_times > 0) {
-    log_.warn(kCloud, "time",
-              topicName(kCloud) + ": " + std::to_string(cloud.bad_times) + " of " +
-                  std::to_string(cloud.cloud.size()) + " points of the sweep at " +
-                  stampText(match.sweep_stamp) + " have a '" + report.point_time_field +
-                  "' time that is NaN or more than ~max_point_time = " +
-                  std::to_string(frame_node_.max_point_time) + " s from the stamp (e.g. " +
-                  std::to_string(cloud.bad_time_example) +
-                  " s): their time is not used (wrong unit or clock?)");
-  }
-  if (!frame_node_.fixed_frame.empty() && !compensateEgoMotion(match, input, cloud, report)) {
-    return;
-  }
-  input.cloud = std::move(cloud.cloud);
-  report.cloud_points = static_cast<int>(input.cloud.size());
-  report.invalid_points = cloud.non_finite + cloud.implausible;
-  report.conversion_ms = msSince(conversion_start);
+  Eigen::Isometry3d T_cam_lidar;
+  if (!lookupExtrinsics(match, T_cam_lidar)) return;
+  EgoMotionTf tf;
+  tf.buffer = &tf_buffer_;
+  tf.wait = [this](const std::string& fixed_frame, const std::string& lidar_frame,
+                   const ros::Time& latest) { waitForTf(fixed_frame, lidar_frame, latest); };
+  PreparedFrame frame = prepareFusionInput(match, T_cam_lidar, frame_node_, tf, topicName(kCloud));
+  reportFrame(frame);
+  if (!frame.accepted()) return;
 
   FusionResult result;
   try {
-    result = pipeline.process(input);
+    result = pipeline.process(frame.input);
   } catch (const std::exception& e) {
     ++counters_.errors;
     log_.log(ThrottledLog::Level::kError, "pipeline", "error",
@@ -274,44 +189,59 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   }
   ROS_DEBUG_STREAM("[" << name_ << "] processed " << stampText(match.image_stamp) << " in "
                        << result.stats.total_ms << " ms");
-  report.method = methodName(pipeline.params().method);
-  outputs_.publish(match, input.camera, input.left, result, pipeline.params(), report);
+  frame.report.method = methodName(pipeline.params().method);
+  outputs_.publish(match, frame.input.camera, frame.input.left, result, pipeline.params(),
+                   frame.report);
 }
 
-bool FusionWorker::compensateEgoMotion(const InputMatch& match, const FusionInput& input,
-                                       conversions::CloudConversion& cloud, FrameReport& report) {
-  const auto start = std::chrono::steady_clock::now();
+bool FusionWorker::lookupExtrinsics(const InputMatch& match, Eigen::Isometry3d& T_cam_lidar) {
+  const std::string& camera_frame = match.images.left->header.frame_id;
   const std::string& lidar_frame = match.sweep->header.frame_id;
-  const std::string& fixed_frame = frame_node_.fixed_frame;
-  const std::vector<double> times =
-      motionSampleTimes(cloud.cloud, cloud.has_time, frame_node_.motion_samples);
+  // At the sweep stamp, or at the image stamp the points are moved to with ~fixed_frame; a short
+  // timeout bounds the wait (worker thread only).
+  const ros::Time stamp =
+      extrinsicsStamp(frame_node_.fixed_frame, match.sweep_stamp, match.image_stamp);
   try {
-    // One bounded wait for the latest instant needed; the samples are then looked up at once.
-    const ros::Time latest =
-        std::max(match.image_stamp, match.sweep_stamp + ros::Duration(times.back()));
-    std::string why;
-    if (!tf_buffer_.canTransform(fixed_frame, lidar_frame, latest,
-                                 ros::Duration(frame_node_.tf_timeout), &why)) {
-      throw tf2::TransformException("no transform from '" + lidar_frame + "' to '" + fixed_frame +
-                                    "' at " + stampText(latest) + " within " +
-                                    std::to_string(frame_node_.tf_timeout) + " s: " + why);
-    }
-    compensateSweep(tf_buffer_, lidar_frame, fixed_frame, match.sweep_stamp, match.image_stamp,
-                    times, input.T_cam_lidar, input.camera, cloud.cloud);
-    report.motion_compensated = true;
+    T_cam_lidar = tf2::transformToEigen(tf_buffer_.lookupTransform(
+        camera_frame, lidar_frame, stamp, ros::Duration(frame_node_.tf_timeout)));
+    return true;
   } catch (const tf2::TransformException& e) {
-    ++counters_.motion_failures;
-    const bool skip = frame_node_.motion_failure == "skip";
-    log_.warn(kCloud, "egomotion",
-              std::string("ego-motion compensation of the sweep at ") +
-                  stampText(match.sweep_stamp) + " to the images at " +
-                  stampText(match.image_stamp) + " failed: " + e.what() +
-                  (skip ? "; frame skipped (~motion_failure: skip)"
-                        : "; frame processed uncompensated (~motion_failure: uncompensated)"));
-    if (skip) return false;
+    ++counters_.tf_failures;
+    log_.warn(kCloud, "tf",
+              "no transform from '" + lidar_frame + "' (" + topicName(kCloud) + ") to '" +
+                  camera_frame + "' (" + topicName(kLeftImage) + ") at " +
+                  (frame_node_.fixed_frame.empty() ? "sweep stamp " : "image stamp ") +
+                  stampText(stamp) + " within " + std::to_string(frame_node_.tf_timeout) +
+                  " s: " + e.what() + "; frame skipped");
+    return false;
   }
-  report.motion_ms = msSince(start);
-  return true;
+}
+
+void FusionWorker::waitForTf(const std::string& fixed_frame, const std::string& lidar_frame,
+                             const ros::Time& latest) {
+  std::string why;
+  if (!tf_buffer_.canTransform(fixed_frame, lidar_frame, latest,
+                               ros::Duration(frame_node_.tf_timeout), &why)) {
+    throw tf2::TransformException("no transform from '" + lidar_frame + "' to '" + fixed_frame +
+                                  "' at " + stampText(latest) + " within " +
+                                  std::to_string(frame_node_.tf_timeout) + " s: " + why);
+  }
+}
+
+void FusionWorker::reportFrame(const PreparedFrame& frame) {
+  if (!frame.report.motion_failure.empty()) ++counters_.motion_failures;
+  for (const FrameNote& note : frame.notes) {
+    if (note.kind != "encodings") {
+      log_.warn(kCloud, note.kind, note.text);
+    } else if (note.text != mixed_encodings_said_) {  // said once per pair of encodings
+      ROS_WARN_STREAM("[" << name_ << "] " << note.text);
+      mixed_encodings_said_ = note.text;
+    }
+  }
+  if (frame.accepted()) return;
+  if (frame.rejection != FrameRejection::kNoEgoMotion) ++counters_.invalid;
+  log_.warn(frame.rejection == FrameRejection::kConversion ? "input set" : kCloud,
+            rejectionKind(frame.rejection), frame.reason + "; frame skipped");
 }
 
 }  // namespace lidar_stereo_fusion

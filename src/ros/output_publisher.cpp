@@ -1,9 +1,7 @@
 #include "lidar_stereo_fusion/ros/output_publisher.h"
 
 #include <algorithm>
-#include <cmath>
 #include <numeric>
-#include <vector>
 
 #include <boost/make_shared.hpp>
 
@@ -163,81 +161,14 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
                               const FusionParams& params, const FrameReport& report) {
   const auto out_start = std::chrono::steady_clock::now();
   const std_msgs::Header& header = match.images.left->header;
-  // One depth range for depth/image_rect and points2: the pipeline's (projection max_depth),
-  // clipped further by ~max_output_depth.
-  const cv::Mat1f depth = outputDepth(result, camera, params_.max_output_depth);
-
-  stereo_msgs::DisparityImagePtr disparity_msg;
-  sensor_msgs::ImagePtr depth_msg, depth_color_msg, prior_msg, disparity_image_msg,
-      disparity_color_msg, confidence_msg;
-  sensor_msgs::CameraInfoPtr depth_info;
-  sensor_msgs::PointCloud2Ptr points_msg;
-  if (pub_disparity_.getNumSubscribers() > 0) {
-    disparity_msg = conversions::disparityToMsg(result.disparity, header, camera,
-                                                params.patchmatch.min_disparity,
-                                                params.patchmatch.max_disparity);
-  }
-  if (pub_disparity_image_.getNumSubscribers() > 0) {
-    disparity_image_msg = conversions::floatImageToMsg(result.disparity, header);
-  }
-  if (pub_disparity_color_.getNumSubscribers() > 0) {
-    // As depth/image_color, with a scale bar in px: up to the frame's 99th percentile of
-    // disparity rounded up to 16 px (the search range, 192 px, or a few near outliers would leave
-    // a street's 5-60 px in one colour); larger ones take the top colour.
-    std::vector<float> values;
-    values.reserve(result.disparity.total());
-    for (const float d : result.disparity) {
-      if (d > 0.f) values.push_back(d);
-    }
-    double top = 16.0;
-    if (!values.empty()) {
-      auto at = values.begin() + static_cast<std::ptrdiff_t>(0.99 * (values.size() - 1));
-      std::nth_element(values.begin(), at, values.end());
-      top = 16.0 * std::max(1.0, std::ceil(*at / 16.0));
-    }
-    const double max = std::min(params.patchmatch.max_disparity, top);
-    disparity_color_msg = conversions::bgrImageToMsg(
-        withColorBar(colorizeDisparity(result.disparity, max), 0.0, max, "px"), header);
-  }
-  if (pub_depth_.getNumSubscribers() > 0) {
-    depth_msg = conversions::depthToMsg(depth, header);
-    depth_info = boost::make_shared<sensor_msgs::CameraInfo>(*match.images.left_info);
-    depth_info->header = header;
-  }
-  if (pub_depth_color_.getNumSubscribers() > 0) {
-    // For RViz's Image display: colours with a scale bar in metres (a grey 32FC1 has no legend).
-    const double max = params_.depth_color_max;
-    depth_color_msg =
-        conversions::bgrImageToMsg(withColorBar(colorizeDepth(depth, max), max, 0.0, "m"), header);
-  }
-  if (pub_lidar_disparity_.getNumSubscribers() > 0) {
-    const cv::Mat1f prior =
-        result.prior.empty() ? cv::Mat1f::zeros(camera.height, camera.width) : result.prior;
-    prior_msg = conversions::floatImageToMsg(prior, header);
-  }
-  if (pub_confidence_.getNumSubscribers() > 0) {
-    // Empty for methods without LiDAR: all 0 (= no prior), so the topic always has a message.
-    const cv::Mat1f confidence = result.confidence.empty()
-                                     ? cv::Mat1f::zeros(camera.height, camera.width)
-                                     : result.confidence;
-    confidence_msg = conversions::floatImageToMsg(confidence, header);
-  }
-  if (pub_points_.getNumSubscribers() > 0) {
-    points_msg =
-        conversions::organizedCloudToMsg(depth, left_image, camera, params_.cloud_stride, header);
-  }
+  Messages messages;
+  makeDisparityMessages(result, camera, params, header, messages);
+  makeDepthMessages(result, camera, left_image, match, messages);
+  makeLidarMessages(result, camera, header, messages);
   const double total_conversion_ms = report.conversion_ms + msSince(out_start);
 
-  // Publish everything as close together as possible.
   const ros::Time publish_time = ros::Time::now();
-  if (disparity_msg) pub_disparity_.publish(disparity_msg);
-  if (depth_msg) pub_depth_.publish(depth_msg, depth_info);
-  if (depth_color_msg) pub_depth_color_.publish(depth_color_msg);
-  if (disparity_image_msg) pub_disparity_image_.publish(disparity_image_msg);
-  if (disparity_color_msg) pub_disparity_color_.publish(disparity_color_msg);
-  if (prior_msg) pub_lidar_disparity_.publish(prior_msg);
-  if (confidence_msg) pub_confidence_.publish(confidence_msg);
-  if (points_msg) pub_points_.publish(points_msg);
+  publishMessages(messages);
   ++counters_.processed;
   const double latency_ms =
       latencyMs(publish_time, match.image_stamp, match.images.arrival_ros,
@@ -247,11 +178,83 @@ void OutputPublisher::publish(const InputMatch& match, const StereoCamera& camer
                                     (match.sweep_stamp - match.image_stamp).toSec(),
                                     counters_.snapshot()));
   }
+  recordFrame(match.image_stamp, result.stats.total_ms + total_conversion_ms, latency_ms);
+}
 
+void OutputPublisher::makeDisparityMessages(const FusionResult& result, const StereoCamera& camera,
+                                            const FusionParams& params,
+                                            const std_msgs::Header& header, Messages& out) const {
+  if (pub_disparity_.getNumSubscribers() > 0) {
+    out.disparity = conversions::disparityToMsg(result.disparity, header, camera,
+                                                params.patchmatch.min_disparity,
+                                                params.patchmatch.max_disparity);
+  }
+  if (pub_disparity_image_.getNumSubscribers() > 0) {
+    out.disparity_image = conversions::floatImageToMsg(result.disparity, header);
+  }
+  if (pub_disparity_color_.getNumSubscribers() > 0) {
+    // As depth/image_color, scaled to the frame's disparities (disparityColorScale).
+    out.disparity_color = conversions::bgrImageToMsg(
+        disparityPicture(result.disparity, params.patchmatch.max_disparity), header);
+  }
+}
+
+void OutputPublisher::makeDepthMessages(const FusionResult& result, const StereoCamera& camera,
+                                        const cv::Mat& left_image, const InputMatch& match,
+                                        Messages& out) const {
+  const std_msgs::Header& header = match.images.left->header;
+  // One depth range for depth/image_rect and points2: the pipeline's (projection max_depth),
+  // clipped further by ~max_output_depth.
+  const cv::Mat1f depth = outputDepth(result, camera, params_.max_output_depth);
+  if (pub_depth_.getNumSubscribers() > 0) {
+    out.depth = conversions::depthToMsg(depth, header);
+    out.depth_info = boost::make_shared<sensor_msgs::CameraInfo>(*match.images.left_info);
+    out.depth_info->header = header;
+  }
+  if (pub_depth_color_.getNumSubscribers() > 0) {
+    // For RViz's Image display: colours with a scale bar in metres (a grey 32FC1 has no legend).
+    out.depth_color =
+        conversions::bgrImageToMsg(depthPicture(depth, params_.depth_color_max), header);
+  }
+  if (pub_points_.getNumSubscribers() > 0) {
+    out.points =
+        conversions::organizedCloudToMsg(depth, left_image, camera, params_.cloud_stride, header);
+  }
+}
+
+void OutputPublisher::makeLidarMessages(const FusionResult& result, const StereoCamera& camera,
+                                        const std_msgs::Header& header, Messages& out) const {
+  // Empty for methods without LiDAR: all 0 (= no prior), so the topics always have a message.
+  const auto orZeros = [&camera](const cv::Mat1f& image) -> cv::Mat1f {
+    if (!image.empty()) return image;
+    return cv::Mat1f::zeros(camera.height, camera.width);
+  };
+  if (pub_lidar_disparity_.getNumSubscribers() > 0) {
+    out.prior = conversions::floatImageToMsg(orZeros(result.prior), header);
+  }
+  if (pub_confidence_.getNumSubscribers() > 0) {
+    out.confidence = conversions::floatImageToMsg(orZeros(result.confidence), header);
+  }
+}
+
+void OutputPublisher::publishMessages(const Messages& m) {
+  // Everything as close together as possible.
+  if (m.disparity) pub_disparity_.publish(m.disparity);
+  if (m.depth) pub_depth_.publish(m.depth, m.depth_info);
+  if (m.depth_color) pub_depth_color_.publish(m.depth_color);
+  if (m.disparity_image) pub_disparity_image_.publish(m.disparity_image);
+  if (m.disparity_color) pub_disparity_color_.publish(m.disparity_color);
+  if (m.prior) pub_lidar_disparity_.publish(m.prior);
+  if (m.confidence) pub_confidence_.publish(m.confidence);
+  if (m.points) pub_points_.publish(m.points);
+}
+
+void OutputPublisher::recordFrame(const ros::Time& image_stamp, double total_ms,
+                                  double latency_ms) {
   output_frequency_.tick();
-  output_stamps_.tick(match.image_stamp);
+  output_stamps_.tick(image_stamp);
   std::lock_guard<std::mutex> lock(mutex_);
-  recent_total_ms_.push_back(result.stats.total_ms + total_conversion_ms);
+  recent_total_ms_.push_back(total_ms);
   recent_latency_ms_.push_back(latency_ms);
   while (recent_total_ms_.size() > kDiagWindow) recent_total_ms_.pop_front();
   while (recent_latency_ms_.size() > kDiagWindow) recent_latency_ms_.pop_front();

@@ -205,6 +205,26 @@ TEST(Visualization, ColourBarBelowThePictureGoesFromLevel0ToLevel255) {
   EXPECT_THROW(withColorBar(cv::Mat1b(2, 2), 0, 1, ""), std::invalid_argument);
 }
 
+// The live node's disparity_image_color scale: the frame's 99th percentile rounded up to 16 px.
+TEST(Visualization, DisparityScaleIsThe99thPercentileRoundedUpTo16Px) {
+  cv::Mat1f d(1, 102, 0.f);
+  for (int i = 0; i < 100; ++i) d(0, i) = static_cast<float>(i + 1);  // 1 .. 100 px
+  d(0, 100) = std::nanf("");                                          // no value, as 0
+  EXPECT_EQ(disparityColorScale(d, 192.0), 112.0);  // 99th percentile 99 px -> 7 x 16
+  EXPECT_EQ(disparityColorScale(d, 64.0), 64.0);    // never beyond the search range
+  EXPECT_EQ(disparityColorScale(cv::Mat1f(2, 2, 0.f), 192.0), 16.0);   // no value: 16 px
+  EXPECT_EQ(disparityColorScale(cv::Mat1f(2, 2, 0.5f), 192.0), 16.0);  // at least 16 px
+  EXPECT_EQ(disparityColorScale(cv::Mat1f(2, 2, 32.f), 192.0), 32.0);  // a multiple stays
+  const cv::Mat picture = disparityPicture(d, 192.0);
+  ASSERT_GT(picture.rows, d.rows);
+  EXPECT_EQ(cv::norm(picture(cv::Rect(0, 0, d.cols, 1)), colorizeDisparity(d, 112.0), cv::NORM_INF),
+            0.0);
+  const cv::Mat1f z = (cv::Mat1f(1, 3) << 0, 5, 40);
+  EXPECT_EQ(cv::norm(depthPicture(z, 80.0), withColorBar(colorizeDepth(z, 80.0), 80.0, 0.0, "m"),
+                     cv::NORM_INF),
+            0.0);
+}
+
 TEST(Report, TablesMedianAndProgress) {
   DepthMetrics m;
   m.mae_mm = 302.4;

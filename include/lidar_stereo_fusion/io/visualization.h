@@ -35,6 +35,20 @@ cv::Mat colorizeConfidence(const cv::Mat1f& confidence, const cv::Mat1f& prior);
 cv::Mat withColorBar(const cv::Mat& picture, double value_at_0, double value_at_255,
                      const std::string& unit, int colormap = cv::COLORMAP_TURBO);
 
+/// The top [px] of a frame's disparity colour scale: the 99th percentile of its disparities (> 0)
+/// rounded up to a multiple of 16 px (16 px when it has none), at most `max_search` (the top of
+/// the search range). The search range (192 px) or a few near outliers as the top would leave a
+/// street's 5-60 px in one colour; disparities above the top take the top colour.
+double disparityColorScale(const cv::Mat1f& disparity, double max_search);
+
+/// The live node's disparity_image_color: colorizeDisparity on [0, disparityColorScale] with a
+/// colour bar in px. Returns BGR8, taller than `disparity` by the bar.
+cv::Mat disparityPicture(const cv::Mat1f& disparity, double max_search);
+
+/// The live node's depth/image_color: colorizeDepth on [0, max_depth] [m] (near = warm) with a
+/// colour bar in m. Returns BGR8, taller than `depth` by the bar.
+cv::Mat depthPicture(const cv::Mat1f& depth, double max_depth);
+
 /// Draws sparse LiDAR disparity as coloured dots over a darkened copy of `image`. Returns BGR8.
 cv::Mat overlaySparse(const cv::Mat& image, const cv::Mat1f& sparse, double max_disparity = 0.0);
 

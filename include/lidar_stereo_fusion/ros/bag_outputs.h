@@ -1,5 +1,5 @@
 // What bag_runner writes for one processed image set: the fusion of a matched set (the node's
-// conversions, ring recovery and the core pipeline), the depth PNG and the optional files, the
+// frame path, frame_input.h, and the core pipeline), the depth PNG and the optional files, the
 // row of frames.csv and the messages of --out-bag. Separate from the bag reading (bag_runner.cpp)
 // so that each stays short.
 #pragma once
@@ -14,6 +14,7 @@
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/ros/bag_pairing.h"
+#include "lidar_stereo_fusion/ros/frame_input.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 
 #include <tf2/buffer_core.h>
@@ -25,18 +26,17 @@ struct FusedSet {
   StereoCamera camera;
   cv::Mat left;  ///< left image as the pipeline saw it
   FusionResult result;
-  cv::Mat1f depth;           ///< the node's published depth [m] (outputDepth), 0 = none
-  double conversion_ms = 0;  ///< message -> core types
-  RingRecovery rings;
-  int cloud_points = 0, invalid_points = 0;
-  bool motion_compensated = false;  ///< moved to the image stamp through ~fixed_frame
-  std::string motion_failure;       ///< why not, with ~fixed_frame set and processed uncompensated
+  cv::Mat1f depth;     ///< the node's published depth [m] (outputDepth), 0 = none
+  FrameReport report;  ///< of prepareFusionInput; report.motion_failure: ~fixed_frame set and
+                       ///< processed uncompensated, why (method: empty, okRow takes it)
 };
 
-/// Runs the fusion on a matched set with LiDAR -> camera `T_cam_lidar`, exactly as the node's
-/// worker does, ego-motion compensation through node_params.fixed_frame included (`tf`: the bag's
-/// /tf and /tf_static). Throws std::runtime_error naming the problem (conversion, no finite point,
-/// pipeline failure, missing ego-motion with ~motion_failure: skip).
+/// Runs the fusion on a matched set with LiDAR -> camera `T_cam_lidar` through the node's frame
+/// path (prepareFusionInput: conversions, ring recovery, ego-motion compensation through
+/// node_params.fixed_frame from `tf`, the bag's /tf and /tf_static), then the core pipeline and
+/// outputDepth, as the node's worker does. Throws std::runtime_error with the frame path's reason
+/// of a rejection (conversion, no finite point, missing ego-motion with ~motion_failure: skip) or
+/// naming a pipeline failure.
 FusedSet fuseSet(const InputMatch& match, const Eigen::Isometry3d& T_cam_lidar,
                  FusionPipeline& pipeline, const NodeParams& node_params,
                  const tf2::BufferCore& tf);

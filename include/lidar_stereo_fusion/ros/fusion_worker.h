@@ -1,7 +1,8 @@
 // The live fusion behind lidar_stereo_fusion/FusionNodelet and fusion_node, in three parts along
 // the data path, each with one lock and its own unit tests (test/ros/test_node_parts.cpp):
 //   InputGate (input_gate.h)           subscription, checks, ~max_rate, sweep pairing in ROS time
-//   FusionWorker (this file)           TF, conversion, ring recovery, the core pipeline, parameters
+//   FusionWorker (this file)           TF, the frame path (frame_input.h), the core pipeline,
+//                                      parameters
 //   OutputPublisher (output_publisher.h)  messages, FusionStats, diagnostics, lazy subscription
 // Inputs (relative to `nh`, remappable; stereo_image_proc-style): left/image_rect_color,
 // left/camera_info, right/image_rect_color, right/camera_info (bgra8, rgba8, bgr8, rgb8 or mono8),
@@ -28,7 +29,7 @@
 
 #include "lidar_stereo_fusion/FusionConfig.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
-#include "lidar_stereo_fusion/ros/conversions.h"
+#include "lidar_stereo_fusion/ros/frame_input.h"
 #include "lidar_stereo_fusion/ros/input_gate.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 #include "lidar_stereo_fusion/ros/output_publisher.h"
@@ -46,12 +47,19 @@ class FusionWorker {
  private:
   void reconfigureCb(FusionConfig& config, uint32_t level);
   void workerLoop();
+  /// The frame path of one matched set: extrinsics from TF, prepareFusionInput (frame_input.h),
+  /// the core pipeline, the outputs.
   void processMatch(const InputMatch& match, FusionPipeline& pipeline);
-  /// Moves the sweep's points to the image stamp through ~fixed_frame (ego_motion.h) and removes
-  /// those the camera cannot see beside near objects (removePointsHiddenBeside). On a TF
-  /// failure: counted and warned; false when the frame is then skipped (~motion_failure: skip).
-  bool compensateEgoMotion(const InputMatch& match, const FusionInput& input,
-                           conversions::CloudConversion& cloud, FrameReport& report);
+  /// LiDAR -> camera at extrinsicsStamp(), waiting up to ~tf_timeout. On a failure: counted,
+  /// warned and false (the frame is skipped).
+  bool lookupExtrinsics(const InputMatch& match, Eigen::Isometry3d& T_cam_lidar);
+  /// EgoMotionTf::wait of the live node: up to ~tf_timeout for `lidar_frame` in `fixed_frame` at
+  /// `latest`; throws tf2::TransformException naming the frames, the stamp and the timeout.
+  void waitForTf(const std::string& fixed_frame, const std::string& lidar_frame,
+                 const ros::Time& latest);
+  /// Counts and logs what the frame path said: its notes (throttled; the mixed-encoding note once
+  /// per pair of encodings), an ego-motion failure, a rejection.
+  void reportFrame(const PreparedFrame& frame);
   std::string topicName(const std::string& relative) const { return nh_.resolveName(relative); }
 
   ros::NodeHandle nh_, pnh_;

@@ -25,28 +25,20 @@
 #include <diagnostic_updater/update_functions.h>
 #include <image_transport/image_transport.h>
 #include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <stereo_msgs/DisparityImage.h>
 #include <opencv2/core.hpp>
 
 #include "lidar_stereo_fusion/FusionStats.h"
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/ros/frame_input.h"
 #include "lidar_stereo_fusion/ros/input_gate.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 
 namespace lidar_stereo_fusion {
-
-/// What the worker knows of a frame beyond the core's result.
-struct FrameReport {
-  std::string method;
-  double conversion_ms = 0;  ///< ROS conversion in (the output conversion is added here)
-  int cloud_points = 0;      ///< finite points of the sweep
-  int invalid_points = 0;    ///< points dropped: NaN / inf, or beyond kMaxCoordinate
-  RingRecovery rings;
-  std::string point_time_field = "none";  ///< conversions::pointTimeFieldName
-  int bad_times = 0;                      ///< points whose time was not used
-  bool motion_compensated = false;        ///< moved to the image stamp through ~fixed_frame
-  double motion_ms = 0;                   ///< TF sampling and moving the points
-};
 
 /// Latency [ms] from the image stamp to `publish_time` (ROS time). When ROS time restarted after
 /// the set arrived (`restarted`, or publish_time before the arrival: a bag loop), the latency at
@@ -87,6 +79,26 @@ class OutputPublisher {
                const FusionResult& result, const FusionParams& params, const FrameReport& report);
 
  private:
+  /// The messages of one frame, each made only when its output has a subscriber.
+  struct Messages {
+    stereo_msgs::DisparityImagePtr disparity;
+    sensor_msgs::ImagePtr disparity_image, disparity_color, depth, depth_color, prior, confidence;
+    sensor_msgs::CameraInfoPtr depth_info;
+    sensor_msgs::PointCloud2Ptr points;
+  };
+  /// disparity, disparity_image, disparity_image_color.
+  void makeDisparityMessages(const FusionResult& result, const StereoCamera& camera,
+                             const FusionParams& params, const std_msgs::Header& header,
+                             Messages& out) const;
+  /// depth/image_rect + depth/camera_info, depth/image_color, points2 (all from outputDepth).
+  void makeDepthMessages(const FusionResult& result, const StereoCamera& camera,
+                         const cv::Mat& left_image, const InputMatch& match, Messages& out) const;
+  /// lidar_disparity, confidence.
+  void makeLidarMessages(const FusionResult& result, const StereoCamera& camera,
+                         const std_msgs::Header& header, Messages& out) const;
+  void publishMessages(const Messages& messages);
+  /// The frame in the output diagnostics: rate, stamp, processing time and latency [ms].
+  void recordFrame(const ros::Time& image_stamp, double total_ms, double latency_ms);
   void connectCb();
   void diagnoseOutput(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnoseProcessing(diagnostic_updater::DiagnosticStatusWrapper& stat);
