@@ -1,7 +1,7 @@
 // accuracy_report: every method on every accuracy protocol (Middlebury pseudo-LiDAR layouts, KITTI
 // ring hold-out, KITTI dense LiDAR against an accumulated reference), with per-region figures, as
-// Markdown tables. The protocols themselves are in io/accuracy_protocols.h and
-// io/accuracy_dense.h; this tool parses options and prints.
+// Markdown tables. The protocols themselves are in eval/accuracy_protocols.h and
+// eval/accuracy_dense.h; this tool parses options and prints.
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -10,9 +10,9 @@
 #include <sstream>
 #include <string>
 
-#include "lidar_stereo_fusion/io/accuracy_dense.h"
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
-#include "lidar_stereo_fusion/io/accuracy_tables.h"
+#include "lidar_stereo_fusion/eval/accuracy_dense.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/accuracy_tables.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
@@ -203,7 +203,7 @@ int run(const Options& o) {
   const lsf::AccuracyOptions options = accuracyOptions(o);
   std::cout << "Scoring: empty pixels filled like the KITTI devkit's interpolateBackground "
                "(gaps in a row take the nearer neighbour), then scored; 'raw coverage' is before "
-               "the fill. Regions: see io/accuracy_protocols.h.\n\n";
+               "the fill. Regions: see eval/accuracy_protocols.h.\n\n";
   if (o.middlebury) printMiddlebury(options);
   if (o.kitti) printKitti(options);
   if (o.dense) printDense(options);

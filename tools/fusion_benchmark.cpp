@@ -20,10 +20,10 @@
 #include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/core/upsampling.h"
+#include "lidar_stereo_fusion/eval/report.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
-#include "lidar_stereo_fusion/io/report.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/sim/synthetic_frame.h"
 

@@ -14,14 +14,15 @@
 #include "lidar_stereo_fusion/core/depth.h"
 #include "lidar_stereo_fusion/core/metrics.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/eval/holdout.h"
+#include "lidar_stereo_fusion/eval/photometric_check.h"
+#include "lidar_stereo_fusion/eval/report.h"
 #include "lidar_stereo_fusion/io/cli.h"
-#include "lidar_stereo_fusion/io/holdout.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/kitti_sweep.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
 #include "lidar_stereo_fusion/io/pcd.h"
-#include "lidar_stereo_fusion/io/photometric_check.h"
-#include "lidar_stereo_fusion/io/report.h"
+#include "lidar_stereo_fusion/io/progress.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
 
 namespace lsf = lidar_stereo_fusion;

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 
 namespace lidar_stereo_fusion {
 namespace {

@@ -6,10 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include "lidar_stereo_fusion/eval/holdout.h"
+#include "lidar_stereo_fusion/eval/report.h"
 #include "lidar_stereo_fusion/io/cli.h"
-#include "lidar_stereo_fusion/io/holdout.h"
 #include "lidar_stereo_fusion/io/middlebury.h"
-#include "lidar_stereo_fusion/io/report.h"
+#include "lidar_stereo_fusion/io/progress.h"
 #include "lidar_stereo_fusion/io/visualization.h"
 
 namespace lidar_stereo_fusion {

@@ -1,11 +1,11 @@
-// The accumulated depth reference's rule (io/kitti_accumulated.h, accumulateDepth) on a hand-made
+// The accumulated depth reference's rule (eval/kitti_accumulated.h, accumulateDepth) on a hand-made
 // scene with exact answers: a wall at 10 m seen by the own sweep on every 4th row; the other
 // sweep's points are kept when their depth lies within 5 % of the own depth range around them,
 // removed when behind or in front of the wall or when no own point is near; the nearest point
 // wins a pixel; the other sweep's pose is applied.
 #include <gtest/gtest.h>
 
-#include "lidar_stereo_fusion/io/kitti_accumulated.h"
+#include "lidar_stereo_fusion/eval/kitti_accumulated.h"
 
 namespace lidar_stereo_fusion {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "lidar_stereo_fusion/io/photometric_check.h"
+#include "lidar_stereo_fusion/eval/photometric_check.h"
 
 namespace lidar_stereo_fusion {
 namespace {

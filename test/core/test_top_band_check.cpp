@@ -1,9 +1,9 @@
-// checkTopBand (io/top_band_check.h) on small synthetic frames with exact counts.
+// checkTopBand (eval/top_band_check.h) on small synthetic frames with exact counts.
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
 
-#include "lidar_stereo_fusion/io/top_band_check.h"
+#include "lidar_stereo_fusion/eval/top_band_check.h"
 
 namespace lsf = lidar_stereo_fusion;
 

@@ -1,4 +1,4 @@
-// The accuracy protocols (io/accuracy_protocols.h) on the real data, with the fast methods only
+// The accuracy protocols (eval/accuracy_protocols.h) on the real data, with the fast methods only
 // (lidar_bi and nearest; PatchMatch rows are the accuracy_report tool's job): layouts feed exactly
 // the stated rows / rings, the devkit fill leaves no reference pixel empty, the regions partition
 // the reference pixels, and LiDAR-only BI* is accurate on the dense 64-row pseudo-LiDAR.
@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "data/data_guard.h"
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 #include "lidar_stereo_fusion/io/middlebury.h"
 
 namespace lidar_stereo_fusion {

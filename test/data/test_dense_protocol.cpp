@@ -1,5 +1,5 @@
-// The dense-LiDAR protocol on the real KITTI drive 0009 (io/accuracy_dense.h): the reference
-// accumulated from sweeps 15-25 around frame 20 (io/kitti_accumulated.h) is dense, agrees with
+// The dense-LiDAR protocol on the real KITTI drive 0009 (eval/accuracy_dense.h): the reference
+// accumulated from sweeps 15-25 around frame 20 (eval/kitti_accumulated.h) is dense, agrees with
 // frame 20's own sweep, and depends on the OXTS poses; a missing sweep is named; the protocol
 // scores every pixel of the reference in exactly one depth band, and IP-Basic beats the nearest
 // LiDAR point and LiDAR-only BF* on it. Missing data fails under CI=true and skips otherwise.
@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 
 #include "data/data_guard.h"
-#include "lidar_stereo_fusion/io/accuracy_dense.h"
-#include "lidar_stereo_fusion/io/kitti_accumulated.h"
+#include "lidar_stereo_fusion/eval/accuracy_dense.h"
+#include "lidar_stereo_fusion/eval/kitti_accumulated.h"
 
 namespace lidar_stereo_fusion {
 namespace {

@@ -1,5 +1,5 @@
-// Ring hold-out on the real KITTI drive (io/accuracy_protocols.h): 32 rings fed (ring % 2 == 0) and
-// 16 rings fed (ring % 4 == 0), every other ring's points the reference depth, 11 frames, empty
+// Ring hold-out on the real KITTI drive (eval/accuracy_protocols.h): 32 rings fed (ring % 2 == 0)
+// and 16 rings fed (ring % 4 == 0), every other ring's points the reference depth, 11 frames, empty
 // pixels filled like the KITTI devkit before scoring. The default fused method and the live preset
 // (config/live.yaml) must each have a lower MAE and a lower >3 px rate than LiDAR-only BI* on
 // both, by a margin; the paper preset must reproduce the fused_bi numbers of the package before
@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "data/data_guard.h"
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
 
 namespace lidar_stereo_fusion {

@@ -1,5 +1,5 @@
 // Middlebury 2003 cones and teddy (quarter size) with a pseudo-LiDAR sampled from the ground truth
-// on 64 rows, 16 rows, and 42 rows over the lower 2/3 only (io/accuracy_protocols.h), scored over
+// on 64 rows, 16 rows, and 42 rows over the lower 2/3 only (eval/accuracy_protocols.h), scored over
 // every ground-truth pixel after the KITTI devkit's fill. On every layout (mean of the two scenes)
 // the default fused method, and the live preset (config/live.yaml), must each have a lower MAE and
 // a lower bad-2 rate than each of LiDAR-only BI*, plain PMS, "LiDAR-only else PMS" and the
@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "data/data_guard.h"
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 #include "lidar_stereo_fusion/io/middlebury.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
 

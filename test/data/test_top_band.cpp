@@ -1,5 +1,5 @@
 // No band of near planes along the top of the LiDAR's view on the real KITTI drive 0009
-// (io/top_band_check.h): in at most 2 % of the columns whose topmost LiDAR point is beyond 10 m
+// (eval/top_band_check.h): in at most 2 % of the columns whose topmost LiDAR point is beyond 10 m
 // may the output within 6 rows above that point be nearer than 0.6 x its depth, unless the LiDAR
 // beside the column or the images show a nearer surface there. Before the hole fill stopped at
 // each column's top (fillPriorHoles), 5-9 % of the columns of most frames were banded.
@@ -10,9 +10,9 @@
 
 #include "data/data_guard.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/eval/top_band_check.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
-#include "lidar_stereo_fusion/io/top_band_check.h"
 
 namespace lidar_stereo_fusion {
 namespace {

@@ -13,7 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "demo_case.h"
-#include "lidar_stereo_fusion/io/holdout.h"
+#include "lidar_stereo_fusion/eval/holdout.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/sim/occlusion_truth.h"
 

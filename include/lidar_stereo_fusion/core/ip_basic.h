@@ -1,7 +1,7 @@
 // IP-Basic, a LiDAR-only baseline: Ku, Harakeh, Waslander, "In Defense of Classical Image
 // Processing: Fast Depth Completion on the CPU", CRV 2018, its "fast" variant (Section III,
 // Fig. 2): morphology and blurs on the inverted depth map. Not part of the fused method; the
-// accuracy protocols (io/accuracy_protocols.h) run it beside the other LiDAR-only rows.
+// accuracy protocols (eval/accuracy_protocols.h) run it beside the other LiDAR-only rows.
 //
 // The steps, in the paper's order (ipBasicFill):
 //  1. inversion: D_inv = max_depth - D on the pixels with a value, so that dilation (a maximum)

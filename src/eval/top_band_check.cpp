@@ -1,5 +1,5 @@
 // The check for near planes along the top of the LiDAR's view (readings in top_band_check.h).
-#include "lidar_stereo_fusion/io/top_band_check.h"
+#include "lidar_stereo_fusion/eval/top_band_check.h"
 
 #include <algorithm>
 #include <cmath>

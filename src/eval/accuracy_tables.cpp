@@ -1,11 +1,11 @@
 // Markdown tables of the accuracy protocols.
-#include "lidar_stereo_fusion/io/accuracy_tables.h"
+#include "lidar_stereo_fusion/eval/accuracy_tables.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <utility>
 
-#include "lidar_stereo_fusion/io/report.h"
+#include "lidar_stereo_fusion/eval/report.h"
 
 namespace lidar_stereo_fusion {
 namespace {

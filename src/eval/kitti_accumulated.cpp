@@ -1,5 +1,5 @@
 // The accumulated KITTI depth reference: posed sweeps, z-buffer, removal against the own sweep.
-#include "lidar_stereo_fusion/io/kitti_accumulated.h"
+#include "lidar_stereo_fusion/eval/kitti_accumulated.h"
 
 #include <algorithm>
 #include <cmath>

@@ -8,8 +8,8 @@
 //  * KITTI raw drive 0009 ring hold-out (makeRingHoldout): "ring32" feeds rings with ring % 2 == 0,
 //    "ring16" rings with ring % 4 == 0; all other rings' points are the reference depth. Scored
 //    with evaluateDepth; mean over frames (averageMetrics).
-//  * KITTI raw drive 0009 dense LiDAR (io/accuracy_dense.h): "dense" feeds frame 20's full sweep
-//    and scores against the depth accumulated from sweeps 15-25 (io/kitti_accumulated.h).
+//  * KITTI raw drive 0009 dense LiDAR (eval/accuracy_dense.h): "dense" feeds frame 20's full sweep
+//    and scores against the depth accumulated from sweeps 15-25 (eval/kitti_accumulated.h).
 //
 // Scoring rule for every method: empty pixels are first filled by fillLikeDevkit (the KITTI
 // devkit's interpolateBackground), as the KITTI benchmark does; "raw coverage" reports the fraction

@@ -1,11 +1,11 @@
-// Markdown tables of the accuracy protocols (io/accuracy_protocols.h). ROS-free.
+// Markdown tables of the accuracy protocols (eval/accuracy_protocols.h). ROS-free.
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
-#include "lidar_stereo_fusion/io/kitti_accumulated.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/kitti_accumulated.h"
 
 namespace lidar_stereo_fusion {
 
@@ -30,7 +30,7 @@ std::string formatKittiRegions(const LayoutScores<DepthMetrics>& layout);
 /// band's share of the reference pixels [%].
 std::string formatDepthBands(const LayoutScores<DepthMetrics>& layout);
 
-/// How an accumulated reference was built (io/kitti_accumulated.h), as a two-column table.
+/// How an accumulated reference was built (eval/kitti_accumulated.h), as a two-column table.
 std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference);
 
 }  // namespace lidar_stereo_fusion

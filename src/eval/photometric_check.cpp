@@ -1,5 +1,5 @@
 // Best sub-pixel shift between a left patch at a LiDAR pixel and the right image (ZNCC).
-#include "lidar_stereo_fusion/io/photometric_check.h"
+#include "lidar_stereo_fusion/eval/photometric_check.h"
 
 #include <algorithm>
 #include <cmath>

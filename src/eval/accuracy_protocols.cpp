@@ -1,5 +1,5 @@
 // The Middlebury and KITTI ring hold-out protocols: every method, every layout, every region.
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "lidar_stereo_fusion/core/depth.h"
-#include "lidar_stereo_fusion/io/holdout.h"
+#include "lidar_stereo_fusion/eval/holdout.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/middlebury.h"
 

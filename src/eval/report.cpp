@@ -1,11 +1,8 @@
-// Text tables and a progress bar.
-#include "lidar_stereo_fusion/io/report.h"
+// Text tables of depth metrics and stage timings.
+#include "lidar_stereo_fusion/eval/report.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
-#include <ostream>
-#include <stdexcept>
 
 namespace lidar_stereo_fusion {
 
@@ -36,10 +33,6 @@ namespace {
 using table::format;
 using table::row;
 using table::separator;
-
-double nowSeconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 }  // namespace
 
@@ -113,38 +106,6 @@ std::string formatTimingSummary(const std::vector<FrameStats>& stats) {
          format("%.1f", 100 * prior / n) + " %, output coverage " +
          format("%.1f", 100 * output / n) + " %\n";
   return out;
-}
-
-ProgressBar::ProgressBar(std::ostream& out, int total, bool interactive, int width)
-    : out_(out), total_(total), interactive_(interactive), width_(width), start_s_(nowSeconds()) {
-  if (total < 0 || width < 1) throw std::invalid_argument("ProgressBar: total < 0 or width < 1");
-}
-
-void ProgressBar::update(int done, const std::string& note) {
-  const int clamped = std::clamp(done, 0, total_);
-  const int filled = total_ > 0 ? width_ * clamped / total_ : width_;
-  std::string bar(static_cast<size_t>(filled), '=');
-  if (filled < width_) bar += '>';
-  bar.resize(static_cast<size_t>(width_), ' ');
-  const double elapsed = nowSeconds() - start_s_;
-  std::string line =
-      "[" + bar + "] " + std::to_string(clamped) + "/" + std::to_string(total_) + " " + note;
-  if (clamped > 0) line += "  " + format("%.2f", elapsed / clamped) + " s/frame";
-  // The time left at the mean rate so far.
-  if (clamped > 0 && clamped < total_) {
-    line += ", ETA " + format("%.0f", elapsed / clamped * (total_ - clamped)) + " s";
-  }
-  if (interactive_) {
-    out_ << "\r" << line << "\033[K" << std::flush;  // \033[K clears the rest of the line
-    open_line_ = true;
-  } else {
-    out_ << line << "\n" << std::flush;
-  }
-}
-
-void ProgressBar::finish() {
-  if (open_line_) out_ << "\n" << std::flush;
-  open_line_ = false;
 }
 
 }  // namespace lidar_stereo_fusion

@@ -1,5 +1,5 @@
 // The dense-LiDAR protocol: frame 20's full sweep in, the accumulated reference out.
-#include "lidar_stereo_fusion/io/accuracy_dense.h"
+#include "lidar_stereo_fusion/eval/accuracy_dense.h"
 
 #include <algorithm>
 #include <filesystem>

@@ -1,5 +1,5 @@
 // Ring hold-out: every keep_every-th ring in, the other rings as the reference depth.
-#include "lidar_stereo_fusion/io/holdout.h"
+#include "lidar_stereo_fusion/eval/holdout.h"
 
 #include <cmath>
 #include <stdexcept>

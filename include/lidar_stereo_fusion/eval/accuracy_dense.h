@@ -1,15 +1,15 @@
 // The dense-LiDAR accuracy protocol: KITTI raw drive 0009, frame 20, the full sweep (64 rings,
 // rings recovered from the sweep order as kitti::loadFrame does) fed to every method, scored
-// against the depth accumulated from sweeps 15-25 (io/kitti_accumulated.h: OXTS poses, points
+// against the depth accumulated from sweeps 15-25 (eval/kitti_accumulated.h: OXTS poses, points
 // that disagree with frame 20's own sweep removed, frame 20's own sweep included, as in KITTI's
 // depth-completion ground truth). Empty pixels are filled like the devkit (fillLikeDevkit) before
-// scoring, as in the other protocols. Regions as io/accuracy_protocols.h (above / inside / edge /
+// scoring, as in the other protocols. Regions as eval/accuracy_protocols.h (above / inside / edge /
 // elsewhere from the fed projection) plus the depth bands < 10 m, 10-30 m, >= 30 m of the
 // reference depth. ROS-free.
 #pragma once
 
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
-#include "lidar_stereo_fusion/io/kitti_accumulated.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/kitti_accumulated.h"
 
 namespace lidar_stereo_fusion {
 

@@ -1,6 +1,6 @@
-// What the accuracy protocols share (io/accuracy_protocols.h, io/accuracy_dense.h): scoring with
-// the devkit fill per region, the rows that run, their accumulation, and every method on one KITTI
-// case (a fed cloud and a reference depth). Private to src/io.
+// What the accuracy protocols share (eval/accuracy_protocols.h, eval/accuracy_dense.h): scoring
+// with the devkit fill per region, the rows that run, their accumulation, and every method on one
+// KITTI case (a fed cloud and a reference depth). Private to src/eval.
 #pragma once
 
 #include <chrono>
@@ -11,7 +11,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 
 namespace lidar_stereo_fusion {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "lidar_stereo_fusion/core/upsampling.h"
-#include "lidar_stereo_fusion/io/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 
 namespace lidar_stereo_fusion {
 namespace {
