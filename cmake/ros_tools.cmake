@@ -1,5 +1,8 @@
 # Targets of the ROS tools (calibration publishers, bag converter). Included after the core
 # targets and cmake/ros_targets.cmake, with catkin already set up (cmake/ros_catkin.cmake).
+# Their sources are in tools/ros/ (as tools/ holds the ROS-free tools): tools/ros/<tool>.cpp, a
+# tool's own further sources in tools/ros/<tool>/, and the messages shared by several in
+# tools/ros/calibration_msgs/.
 #
 #   autoware_calibration_publisher  static TF lidar -> camera (+ camera_info) from Autoware YAML
 #   kitti_calibration_publisher     static TF velodyne -> left -> right camera from KITTI calib
@@ -10,8 +13,8 @@
 
 # ROS messages built from the ROS-free calibration readers (and the KITTI oxts ego-motion as TF);
 # shared by the tools and their tests.
-add_library(${PROJECT_NAME}_calibration_msgs STATIC src/ros/calibration_msgs.cpp
-  src/ros/kitti_ego_motion.cpp)
+add_library(${PROJECT_NAME}_calibration_msgs STATIC
+  tools/ros/calibration_msgs/calibration_msgs.cpp tools/ros/calibration_msgs/kitti_ego_motion.cpp)
 target_include_directories(${PROJECT_NAME}_calibration_msgs SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
 target_link_libraries(${PROJECT_NAME}_calibration_msgs PUBLIC
   ${PROJECT_NAME}_io ${catkin_LIBRARIES})
@@ -20,9 +23,9 @@ if(catkin_EXPORTED_TARGETS)
   add_dependencies(${PROJECT_NAME}_calibration_msgs ${catkin_EXPORTED_TARGETS})
 endif()
 
-add_executable(autoware_calibration_publisher src/ros/calibration_autoware_publisher.cpp)
-add_executable(kitti_calibration_publisher src/ros/calibration_kitti_publisher.cpp)
-add_executable(kitti_to_bag src/ros/kitti_to_bag.cpp src/ros/kitti_bag_frames.cpp)
+add_executable(autoware_calibration_publisher tools/ros/autoware_calibration_publisher.cpp)
+add_executable(kitti_calibration_publisher tools/ros/kitti_calibration_publisher.cpp)
+add_executable(kitti_to_bag tools/ros/kitti_to_bag.cpp tools/ros/kitti_to_bag/kitti_bag_frames.cpp)
 set(LSF_ROS_TOOLS autoware_calibration_publisher kitti_calibration_publisher kitti_to_bag)
 foreach(tool ${LSF_ROS_TOOLS})
   target_link_libraries(${tool} ${PROJECT_NAME}_calibration_msgs)

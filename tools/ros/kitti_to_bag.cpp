@@ -38,7 +38,7 @@
 // Only frames with image_02, image_03, a Velodyne sweep and non-blank image and Velodyne stamps
 // are written (KITTI leaves blank lines for dropped sweeps); the others are listed as skipped.
 // Exit status: 0 written, 1 bad input or write failure, 2 bad command line.
-// The choice of the frames and their stamps (and --period restamping): kitti_bag_frames.cpp.
+// The frames and their stamps (and --period restamping): kitti_to_bag/kitti_bag_frames.cpp.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -61,12 +61,12 @@
 #include <tf2_msgs/TFMessage.h>
 #include <boost/make_shared.hpp>
 
+#include "kitti_to_bag/kitti_bag_frames.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/kitti_sweep.h"
 #include "lidar_stereo_fusion/ros/calibration_msgs.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
-#include "lidar_stereo_fusion/ros/kitti_bag_frames.h"
 #include "lidar_stereo_fusion/ros/kitti_ego_motion.h"
 
 namespace lsf = lidar_stereo_fusion;

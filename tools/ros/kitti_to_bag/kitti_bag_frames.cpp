@@ -1,5 +1,5 @@
 // kitti_to_bag's choice of frames and their stamps (see kitti_bag_frames.h).
-#include "lidar_stereo_fusion/ros/kitti_bag_frames.h"
+#include "kitti_bag_frames.h"
 
 #include <cmath>
 #include <cstddef>
