@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Builds the ROS-free layers, tools and tests (core, io, sim; test_core, test_data) with plain CMake
-# under AddressSanitizer + UndefinedBehaviorSanitizer and runs them with ctest. No ROS needed.
+# Builds the ROS-free layers, tools and tests (core, io, sim, eval; test_core, test_io, test_sim,
+# test_eval, test_tools, test_data) with plain CMake under AddressSanitizer +
+# UndefinedBehaviorSanitizer and runs them with ctest. No ROS needed.
 # Usage: bash scripts/run_sanitizers.sh        (build folder: <repo>/build_asan, ignored by git)
 # Env:   LSF_ASAN_BUILD=<dir>, LSF_JOBS=<n> (default 2), LSF_DATA_DIR as for the tests.
 set -euo pipefail

@@ -1,11 +1,10 @@
-// Which SIMD path the matching cost runs (the widest the CPU has, LSF_SIMD in the tools, an
-// unsupported one refused) and whole PatchMatch runs on every path giving the baseline's result.
-// The kernels themselves: test_cost_simd_kernels.cpp.
+// Which SIMD path the matching cost runs (the widest the CPU has, an unsupported one refused) and
+// whole PatchMatch runs on every path giving the baseline's result. The kernels themselves:
+// test_cost_simd_kernels.cpp; LSF_SIMD in the tools: test/io/test_simd_env.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -14,7 +13,6 @@
 #include "lidar_stereo_fusion/core/patchmatch.h"
 #include "lidar_stereo_fusion/core/patchmatch/simd.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
-#include "lidar_stereo_fusion/io/simd_env.h"
 #include "test_scenes.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -22,29 +20,6 @@ namespace lsf = lidar_stereo_fusion;
 using lidar_stereo_fusion::test::widePaths;
 
 namespace {
-
-/// Sets (or unsets, for nullptr) LSF_SIMD while a test runs, and restores it when it ends.
-class SimdEnvironment {
- public:
-  explicit SimdEnvironment(const char* value) {
-    const char* old = std::getenv("LSF_SIMD");
-    had_ = old != nullptr;
-    if (had_) saved_ = old;
-    set(value);
-  }
-  ~SimdEnvironment() { set(had_ ? saved_.c_str() : nullptr); }
-  void set(const char* value) {
-    if (value == nullptr) {
-      unsetenv("LSF_SIMD");
-    } else {
-      setenv("LSF_SIMD", value, 1);
-    }
-  }
-
- private:
-  bool had_ = false;
-  std::string saved_;
-};
 
 /// Fraction of pixels where two disparity maps differ by more than 1e-3 px.
 double differingFraction(const cv::Mat1f& a, const cv::Mat1f& b) {
@@ -81,29 +56,6 @@ TEST(CostSimd, DefaultsToTheWidestPath) {
   EXPECT_EQ(untouched, lsf::SimdPath::kAvx2);
   std::printf("[          ] widest path %s; AVX2 + FMA %s, AVX-512 %s\n", level.c_str(),
               lsf::cpuHasAvx2Fma() ? "yes" : "no", lsf::cpuHasAvx512() ? "yes" : "no");
-}
-
-TEST(CostSimd, ToolsTakeThePathFromLsfSimd) {
-  const lsf::SimdPath widest = lsf::widestSimdPath();
-  SimdEnvironment env(nullptr);
-  EXPECT_EQ(lsf::simdPathFromEnvironment(), widest);  // unset: the widest
-  env.set("");
-  EXPECT_EQ(lsf::simdPathFromEnvironment(), widest);
-  env.set("baseline");
-  EXPECT_EQ(lsf::simdPathFromEnvironment(), lsf::SimdPath::kBaseline);
-  env.set("avx2");  // a cap: baseline on a CPU without AVX2
-  EXPECT_EQ(lsf::simdPathFromEnvironment(), lsf::capSimdPath(lsf::SimdPath::kAvx2));
-  env.set("avx512");
-  EXPECT_EQ(lsf::simdPathFromEnvironment(), widest);
-  env.set("fastest");
-  std::string warning;
-  EXPECT_EQ(lsf::simdPathFromEnvironment(&warning), widest);
-  EXPECT_NE(warning.find("LSF_SIMD=fastest is not baseline, avx2 or avx512"), std::string::npos)
-      << warning;
-  env.set("baseline");
-  lsf::FusionParams params;
-  EXPECT_EQ(lsf::applySimdEnvironment(params), lsf::SimdPath::kBaseline);
-  EXPECT_EQ(params.patchmatch.simd_path, lsf::SimdPath::kBaseline);
 }
 
 TEST(CostSimd, AnUnsupportedPathIsRejected) {

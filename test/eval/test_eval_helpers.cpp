@@ -1,0 +1,117 @@
+// The small evaluation helpers on synthetic input with exact answers: ring hold-out, metric
+// tables.
+#include <gtest/gtest.h>
+
+#include "lidar_stereo_fusion/eval/holdout.h"
+#include "lidar_stereo_fusion/eval/report.h"
+
+namespace lidar_stereo_fusion {
+namespace {
+
+StereoCamera camera() {
+  StereoCamera c;
+  c.fx = c.fy = 100.0;
+  c.cx = 10.0;
+  c.cy = 5.0;
+  c.baseline = 0.5;
+  c.width = 20;
+  c.height = 10;
+  return c;
+}
+
+LidarPoint point(float x, float y, float z, int ring) {
+  LidarPoint p;
+  p.x = x;
+  p.y = y;
+  p.z = z;
+  p.ring = ring;
+  return p;
+}
+
+TEST(RingHoldout, SplitsByRingParityAndRejectsPointsWithoutRing) {
+  const LidarCloud cloud = {point(0, 0, 1, 0), point(0, 0, 2, 1), point(0, 0, 3, 2),
+                            point(0, 0, 4, 5)};
+  const RingSplit split = splitRingsEvenOdd(cloud);
+  ASSERT_EQ(split.fed.size(), 2u);
+  ASSERT_EQ(split.held_out.size(), 2u);
+  EXPECT_EQ(split.fed[1].z, 3.f);
+  EXPECT_EQ(split.held_out[1].ring, 5);
+  EXPECT_THROW(splitRingsEvenOdd({point(0, 0, 1, -1)}), std::invalid_argument);
+}
+
+TEST(RingHoldout, KeepEveryFourFeedsRingsZeroFourEightAndRejectsKeepEveryBelowTwo) {
+  LidarCloud cloud;
+  for (int ring = 0; ring < 12; ++ring) cloud.push_back(point(0, 0, 1.f + ring, ring));
+  const RingSplit split = splitRings(cloud, 4);
+  ASSERT_EQ(split.fed.size(), 3u);
+  EXPECT_EQ(split.fed[0].ring, 0);
+  EXPECT_EQ(split.fed[1].ring, 4);
+  EXPECT_EQ(split.fed[2].ring, 8);
+  EXPECT_EQ(split.held_out.size(), 9u);
+  for (const LidarPoint& p : split.held_out) EXPECT_NE(p.ring % 4, 0) << p.ring;
+  EXPECT_THROW(splitRings(cloud, 1), std::invalid_argument);
+  // The hold-out with keep_every 4 scores on rings 1-3: a point of ring 3 is the reference.
+  const HoldoutCase holdout =
+      makeRingHoldout({point(0, 0, 10, 0), point(0, 0, 5, 3)}, Eigen::Isometry3d::Identity(),
+                      camera(), ProjectionParams(), 4);
+  ASSERT_EQ(holdout.fed.size(), 1u);
+  EXPECT_EQ(holdout.reference_depth(5, 10), 5.f);
+  EXPECT_THROW(makeRingHoldout({point(0, 0, 10, 0), point(0, 0, 5, 4)},
+                               Eigen::Isometry3d::Identity(), camera(), ProjectionParams(), 4),
+               std::invalid_argument);  // ring 4 is fed: no reference left
+}
+
+TEST(RingHoldout, ReferenceDepthIsTheNearestZPerRoundedPixel) {
+  // Identity transform: the LiDAR frame is the camera frame.
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  const LidarCloud held = {
+      point(0.f, 0.f, 10.f, 1),     // u = 10, v = 5
+      point(0.048f, 0.f, 8.f, 1),   // u = 10.6 -> 11, v = 5
+      point(0.004f, 0.f, 9.f, 1),   // u = 10.04 -> 10: nearer than 10 m, wins
+      point(-0.2f, -0.1f, 2.f, 1),  // u = 0, v = 0
+      point(1.f, 0.f, 2.f, 1),      // u = 60: outside
+      point(0.f, 0.f, 0.2f, 1),     // nearer than min_depth 0.5
+      point(0.f, 0.f, -5.f, 1),     // behind
+  };
+  ProjectionParams params;
+  const cv::Mat1f depth = projectReferenceDepth(held, identity, camera(), params);
+  ASSERT_EQ(depth.size(), cv::Size(20, 10));
+  EXPECT_EQ(depth(5, 10), 9.f);
+  EXPECT_EQ(depth(5, 11), 8.f);
+  EXPECT_EQ(depth(0, 0), 2.f);
+  EXPECT_EQ(cv::countNonZero(depth), 3);
+}
+
+TEST(RingHoldout, MakeRingHoldoutFeedsEvenRingsAndFailsWithoutReference) {
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  const LidarCloud cloud = {point(0, 0, 10, 0), point(0, 0, 12, 1), point(0.1f, 0, 12, 2)};
+  const HoldoutCase holdout = makeRingHoldout(cloud, identity, camera(), ProjectionParams());
+  EXPECT_EQ(holdout.fed.size(), 2u);
+  EXPECT_EQ(holdout.reference_depth(5, 10), 12.f);
+  EXPECT_EQ(cv::countNonZero(holdout.reference_depth), 1);
+  EXPECT_THROW(makeRingHoldout({point(0, 0, 10, 0)}, identity, camera(), ProjectionParams()),
+               std::invalid_argument);
+}
+
+TEST(Report, TablesAndMedian) {
+  DepthMetrics m;
+  m.mae_mm = 302.4;
+  m.rmse_mm = 1282.0;
+  m.bad2 = 0.0452;
+  m.count = 7;
+  const std::string table = formatDepthTable({{"fused_bi", m}});
+  EXPECT_NE(table.find("| fused_bi | 302 | 1282 |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| 4.52 |"), std::string::npos) << table;
+  EXPECT_DOUBLE_EQ(median({3, 1, 2}), 2.0);
+  EXPECT_DOUBLE_EQ(median({4, 1, 2, 3}), 2.5);
+  EXPECT_DOUBLE_EQ(median({}), 0.0);
+  FrameStats a, b, c;
+  a.patchmatch_ms = 10;
+  b.patchmatch_ms = 30;
+  c.patchmatch_ms = 200;
+  const std::string timing = formatTimingSummary({a, b, c});
+  EXPECT_NE(timing.find("| PatchMatch | 80.0 | 30.0 |"), std::string::npos) << timing;
+}
+
+}  // namespace
+}  // namespace lidar_stereo_fusion
