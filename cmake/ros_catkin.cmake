@@ -19,7 +19,7 @@ generate_dynamic_reconfigure_options(cfg/Fusion.cfg)
 catkin_package(
   INCLUDE_DIRS include
   LIBRARIES ${PROJECT_NAME}_core ${PROJECT_NAME}_io ${PROJECT_NAME}_sim ${PROJECT_NAME}_eval
-            ${PROJECT_NAME}_ros
+            ${PROJECT_NAME}_node_params ${PROJECT_NAME}_ros
   CATKIN_DEPENDS roscpp nodelet tf2_ros message_filters cv_bridge image_transport sensor_msgs
                  stereo_msgs std_msgs message_runtime dynamic_reconfigure diagnostic_updater
   DEPENDS OpenCV)

@@ -15,8 +15,6 @@ add_library(${PROJECT_NAME}_ros
   src/ros/cloud_conversions.cpp
   src/ros/ego_motion.cpp
   src/ros/ros_params.cpp
-  src/ros/node_params.cpp
-  src/ros/param_files.cpp
   src/ros/node_support.cpp
   src/ros/stereo_sync.cpp
   src/ros/input_gate.cpp
@@ -28,7 +26,7 @@ add_library(${PROJECT_NAME}_ros
 target_include_directories(${PROJECT_NAME}_ros PUBLIC
   $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
 target_include_directories(${PROJECT_NAME}_ros SYSTEM PUBLIC ${LSF_ROS_INCLUDE_DIRS})
-target_link_libraries(${PROJECT_NAME}_ros PUBLIC ${PROJECT_NAME}_io ${catkin_LIBRARIES})
+target_link_libraries(${PROJECT_NAME}_ros PUBLIC ${PROJECT_NAME}_node_params ${catkin_LIBRARIES})
 # Generated headers (dynamic_reconfigure config, FusionStats message) come first.
 add_dependencies(${PROJECT_NAME}_ros ${PROJECT_NAME}_gencfg ${PROJECT_NAME}_generate_messages_cpp)
 if(catkin_EXPORTED_TARGETS)

@@ -9,7 +9,8 @@
 #   kitti_to_bag                    KITTI raw drive -> ROS 1 bag with the rig's topics
 #   bag_runner                      the fusion on every image set of recorded bags (no roscore)
 #   lsf_batch                       bag_runner over archives of bags on Dask distributed (Python)
-#   lsf_params                      writes (or checks) the files generated from the parameter tables
+# (lsf_params, which writes or checks the files generated from the parameter tables, is a ROS-free
+# tool: tools/lsf_params.cpp.)
 
 # ROS messages built from the ROS-free calibration readers (and the KITTI oxts ego-motion as TF);
 # shared by the tools and their tests.
@@ -39,10 +40,6 @@ target_link_libraries(${PROJECT_NAME}_bag PUBLIC ${PROJECT_NAME}_ros)
 add_executable(bag_runner src/ros/bag_runner.cpp)
 target_link_libraries(bag_runner ${PROJECT_NAME}_bag)
 list(APPEND LSF_ROS_TOOLS bag_runner)
-add_executable(lsf_params src/ros/lsf_params.cpp)
-target_link_libraries(lsf_params ${PROJECT_NAME}_ros)
-target_compile_definitions(lsf_params PRIVATE LSF_SOURCE_DIR="${LSF_REAL_SOURCE_DIR}")
-list(APPEND LSF_ROS_TOOLS lsf_params)
 catkin_install_python(PROGRAMS scripts/lsf_batch DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 install(TARGETS ${LSF_ROS_TOOLS} RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -102,7 +102,7 @@ std::string renderFusionCfg(const std::vector<ParamInfo>& rows) {
          "# GENERATED from the parameter tables (include/lidar_stereo_fusion/core/param_table.h,\n"
          "# include/lidar_stereo_fusion/ros/node_params.h) by `rosrun lidar_stereo_fusion "
          "lsf_params\n"
-         "# --write <source dir>`; do not edit (test_ros_unit fails when it differs).\n"
+         "# --write <source dir>`; do not edit (test_tools fails when it differs).\n"
          "# Live parameters of lidar_stereo_fusion/FusionNodelet:\n"
          "#   rosrun dynamic_reconfigure dynparam set /fusion/fusion window_radius 5\n"
          "# No slider ranges: the server would clamp silently. The node checks every request with\n"

@@ -2,8 +2,9 @@
 #include "lidar_stereo_fusion/ros/param_files.h"
 
 #include "lidar_stereo_fusion/io/param_docs.h"
+#include "lidar_stereo_fusion/io/param_table.h"
 #include "lidar_stereo_fusion/io/text_file.h"
-#include "lidar_stereo_fusion/ros/ros_params.h"
+#include "lidar_stereo_fusion/ros/node_params.h"
 
 namespace lidar_stereo_fusion {
 
@@ -12,7 +13,7 @@ namespace {
 constexpr const char* kFusionYamlHeader =
     R"(The algorithm's parameters (FusionParams) at their defaults: the default preset.
 GENERATED from include/lidar_stereo_fusion/core/param_table.h by
-`rosrun lidar_stereo_fusion lsf_params --write <source dir>`: do not edit (test_ros_unit fails
+`rosrun lidar_stereo_fusion lsf_params --write <source dir>`: do not edit (test_tools fails
 when it differs). Presets that change some of them: config/live.yaml, config/paper.yaml.
 Read by the nodelet (rosparam, private namespace; fusion.launch loads it) and by the tools
 (--params). Each parameter has one name: here, as ~name on the parameter server and in
@@ -23,7 +24,7 @@ constexpr const char* kNodeYamlHeader =
 the algorithm's are in fusion.yaml. fusion.launch loads both into the nodelet's private namespace;
 bag_runner reads this layout with --node-params.
 GENERATED from include/lidar_stereo_fusion/ros/node_params.h by
-`rosrun lidar_stereo_fusion lsf_params --write <source dir>`: do not edit (test_ros_unit fails
+`rosrun lidar_stereo_fusion lsf_params --write <source dir>`: do not edit (test_tools fails
 when it differs). doc/parameters.md explains each; the rows marked live there can also be
 changed with dynamic_reconfigure while the node runs.)";
 
@@ -35,8 +36,8 @@ constexpr const char* kNodeEnd = "<!-- END node parameters -->";
 }  // namespace
 
 std::vector<GeneratedFile> generatedParamFiles(const std::string& source_dir) {
-  const std::vector<ParamInfo> core = ros_params::listParams();
-  const std::vector<ParamInfo> node = ros_params::listNodeParams();
+  const std::vector<ParamInfo> core = paramTable();
+  const std::vector<ParamInfo> node = nodeParamTable();
   std::vector<ParamInfo> both = core;
   both.insert(both.end(), node.begin(), node.end());
 

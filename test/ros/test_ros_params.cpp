@@ -1,6 +1,6 @@
 // The parameter tables (core/param_table.h, ros/node_params.h) against everything made from
-// them: dynamic_reconfigure (cfg/Fusion.cfg), the YAML files, doc/parameters.md, the node's YAML
-// reader and the checks' wording.
+// them: dynamic_reconfigure (cfg/Fusion.cfg), the YAML files, the node's YAML reader and the
+// checks' wording. That the generated files are up to date: test/tools/test_lsf_params.cpp.
 #include <fstream>
 #include <limits>
 #include <map>
@@ -15,7 +15,6 @@
 
 #include "lidar_stereo_fusion/io/params_yaml.h"
 #include "lidar_stereo_fusion/io/text_file.h"
-#include "lidar_stereo_fusion/ros/param_files.h"
 #include "lidar_stereo_fusion/ros/ros_params.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -156,17 +155,6 @@ TEST(RosParams, ShippedYamlHasEveryParameterAtItsDefaultUnderTheOneName) {
   std::set<std::string> names;
   for (const auto& info : lsf::ros_params::listParams()) names.insert(info.name);
   EXPECT_EQ(keys, names) << "config/fusion.yaml: exactly the table's names, no sections";
-}
-
-TEST(RosParams, GeneratedFilesAreWhatTheTablesMake) {
-  // cfg/Fusion.cfg, config/fusion.yaml, config/fusion_node.yaml and doc/parameters.md's tables.
-  for (const auto& file : lsf::generatedParamFiles(LSF_SOURCE_DIR)) {
-    const std::string committed =
-        lsf::readTextFile(std::string(LSF_SOURCE_DIR) + "/" + file.path, "generated file");
-    EXPECT_TRUE(committed == file.contents)
-        << file.path << " differs from the parameter tables (core/param_table.h, "
-        << "ros/node_params.h): run `rosrun lidar_stereo_fusion lsf_params --write`";
-  }
 }
 
 TEST(RosParams, EveryNameIsUniqueAcrossBothTables) {

@@ -15,34 +15,17 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "lidar_stereo_fusion/io/kitti.h"
+#include "tools/tool_runner.h"
 
 namespace lidar_stereo_fusion {
 namespace {
 
 namespace fs = std::filesystem;
 
+using test::RunResult;
+
 /// The runner next to the test (plain CMake) or in the catkin devel space.
-std::string runnerPath() {
-  const fs::path build(LSF_BINARY_DIR);
-  for (const fs::path& candidate :
-       {build / "kitti_runner",
-        build / ".." / ".." / "devel" / "lib" / "lidar_stereo_fusion" / "kitti_runner"}) {
-    if (fs::is_regular_file(candidate)) return candidate.string();
-  }
-  return "";
-}
-
-struct RunResult {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string readAll(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string runnerPath() { return test::toolPath("kitti_runner"); }
 
 /// A synthetic drive "<root>/2011_01_01/drive_sync": 80x60 images, 3 frames, 16-laser sweeps in
 /// KITTI storage order (laser by laser, azimuth from just past 0 through +-180 to just before 0) of
@@ -129,15 +112,7 @@ class SyntheticDrive {
   }
 
   RunResult run(const std::string& args) const {
-    const fs::path out = root_ / "stdout.txt", err = root_ / "stderr.txt";
-    const std::string command = runnerPath() + " --kitti-raw " + drive_.string() + " " + args +
-                                " > " + out.string() + " 2> " + err.string();
-    RunResult r;
-    const int raw = std::system(command.c_str());
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = readAll(out);
-    r.err = readAll(err);
-    return r;
+    return test::runCommand(runnerPath() + " --kitti-raw " + drive_.string() + " " + args, root_);
   }
 
   fs::path drive() const { return drive_; }

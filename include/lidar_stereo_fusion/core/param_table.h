@@ -6,7 +6,7 @@
 //   - each struct's validate(): the ranges (requireRanges), plus the checks between parameters;
 //   - YAML (io/params_yaml.cpp), rosparam and dynamic_reconfigure (ros/ros_params.cpp) by name;
 //   - cfg/Fusion.cfg, config/fusion.yaml and doc/parameters.md are generated from the table
-//     (`rosrun lidar_stereo_fusion lsf_params --write <source dir>`; test_ros_unit fails when a
+//     (`rosrun lidar_stereo_fusion lsf_params --write <source dir>`; test_tools fails when a
 //     committed file differs from what the table generates).
 // Adding a parameter: a field in its struct, a row here, its use and its test; then regenerate.
 #pragma once

@@ -1,6 +1,6 @@
 // The files written from the parameter tables (core/param_table.h, ros/node_params.h): YAML with
 // every row documented, the Markdown tables of doc/parameters.md and cfg/Fusion.cfg. The
-// `lsf_params` tool writes them into the source tree; test_ros_unit fails when a committed file
+// `lsf_params` tool writes them into the source tree; test_tools fails when a committed file
 // differs from what these functions make of the tables.
 #pragma once
 

@@ -1,6 +1,6 @@
 // The files generated from the parameter tables, as they should read: cfg/Fusion.cfg,
 // config/fusion.yaml, config/fusion_node.yaml and the tables in doc/parameters.md. The
-// `lsf_params` tool writes them; test_ros_unit compares them with the committed files.
+// `lsf_params` tool writes (or checks) them; test_tools compares them with the committed files.
 #pragma once
 
 #include <string>
