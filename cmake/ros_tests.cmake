@@ -69,7 +69,8 @@ add_rostest(test/ros/moving_rig.test DEPENDENCIES test_moving_rig)
 
 # Issue 10: depth_image_proc / stereo_image_proc consume the outputs by remapping only; dynparam
 # refusals are visible; silent inputs are named.
-lsf_add_ros_test_node(test_ros_conventions test/ros/test_ros_conventions.cpp test/ros/run_command.cpp)
+lsf_add_ros_test_node(test_ros_conventions test/ros/test_ros_conventions.cpp test/ros/run_command.cpp
+  test/ros/child_process.cpp)
 add_rostest(test/ros/ros_conventions.test DEPENDENCIES test_ros_conventions)
 
 # RViz with rviz/fusion.rviz under Xvfb: the fused cloud is drawn (screenshots in the build folder).

@@ -13,8 +13,10 @@
 //     parameter on the parameter server;
 //   * an input topic that publishes nothing is named in a warning.
 #include <cmath>
+#include <functional>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -23,6 +25,7 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <stereo_msgs/DisparityImage.h>
 
+#include "child_process.h"
 #include "fusion_test_harness.h"
 #include "lidar_stereo_fusion/core/patchmatch.h"
 #include "run_command.h"
@@ -45,6 +48,14 @@ struct Latest {
       std::lock_guard<std::mutex> lock(mutex);
       by_stamp[m->header.stamp.toNSec()] = m;
     });
+  }
+  std::size_t size() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return by_stamp.size();
+  }
+  bool has(const ros::Time& stamp) {
+    std::lock_guard<std::mutex> lock(mutex);
+    return by_stamp.count(stamp.toNSec()) > 0;
   }
   boost::shared_ptr<const M> at(const ros::Time& stamp, double timeout = kOutputTimeout) {
     boost::shared_ptr<const M> out;
@@ -95,17 +106,57 @@ int differingPoints(const sensor_msgs::PointCloud2& a, const sensor_msgs::PointC
   return differ;
 }
 
+/// The node of the image_pipeline nodelets (ros_conventions.test's manager).
+constexpr const char* kImageProcManager = "/image_proc_manager";
+
+/// Each test starts from the node's idle state, whatever ran before: no output subscriber of an
+/// earlier test, so the inputs are unsubscribed (and the silent-input watch restarts when a test
+/// subscribes).
 class RosConventions : public ::testing::Test {
  protected:
+  void SetUp() override {
+    h().unsubscribeOutputs();
+    h().forgetLatestOutputs();
+    ASSERT_TRUE(h().inputsSubscribed(false, 10.0))
+        << "inputs subscribed without output subscribers";
+  }
+  void TearDown() override { h().unsubscribeOutputs(); }
   Harness& h() { return *harness; }
+
+  /// Publishes input sets, one every `period` seconds, until `arrived(stamp)` holds for the stamp
+  /// of one of them (a consumer that subscribes lazily may miss the first sets); waits at most
+  /// `timeout` [s]. Returns that stamp, or ros::Time() when none arrived.
+  ros::Time publishUntil(const std::function<bool(const ros::Time&)>& arrived,
+                         double timeout = 2 * kOutputTimeout, double period = 3.0) {
+    std::vector<ros::Time> sent;
+    ros::Time found;
+    const auto any_arrived = [&] {
+      for (const ros::Time& stamp : sent) {
+        if (arrived(stamp)) {
+          found = stamp;
+          return true;
+        }
+      }
+      return false;
+    };
+    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+    while (ros::WallTime::now() < end) {
+      sent.push_back(h().nextStamp());
+      h().publishSet(SetSpec(), sent.back());
+      if (Harness::waitFor(period, any_arrived)) return found;
+    }
+    return ros::Time();
+  }
+
   ros::NodeHandle nh_;
 };
 
 }  // namespace
 
-// First, before any input: the inputs are subscribed for an output subscriber, the images come,
-// the LiDAR does not; after ~input_timeout (2 s in the .test) a warning names the silent topic.
-TEST_F(RosConventions, A_SilentInputTopicIsNamed) {
+// The inputs are subscribed for an output subscriber, the images come, the LiDAR does not; after
+// ~input_timeout (2 s in the .test) a warning names the silent topic (the watch starts anew with
+// each subscription of the inputs: the fixture's start has none).
+TEST_F(RosConventions, SilentInputTopicIsNamed) {
   const std::size_t mark = h().logMark();
   h().subscribeOutputs({"stats"});
   ASSERT_TRUE(h().inputsSubscribed(true, 10.0));
@@ -121,10 +172,9 @@ TEST_F(RosConventions, A_SilentInputTopicIsNamed) {
   for (const auto& w : h().warningsSince(mark)) {
     EXPECT_EQ(w.find("/stereo/left/image_rect_color: nothing received"), std::string::npos) << w;
   }
-  h().unsubscribeOutputs();
 }
 
-TEST_F(RosConventions, B_OrganisedCloudPixelIsTheDepthPixel) {
+TEST_F(RosConventions, OrganisedCloudPixelIsTheDepthPixel) {
   h().subscribeOutputs({"depth/image_rect", "depth/camera_info", "points2", "disparity"});
   ASSERT_TRUE(h().outputsConnected());
   ASSERT_TRUE(h().inputsSubscribed(true, 10.0));
@@ -169,29 +219,27 @@ TEST_F(RosConventions, B_OrganisedCloudPixelIsTheDepthPixel) {
   const auto disparity = h().disparity();
   EXPECT_FLOAT_EQ(disparity->min_disparity, 1.f);
   EXPECT_FLOAT_EQ(disparity->max_disparity, 192.f);
-  h().unsubscribeOutputs();
 }
 
 // depth_image_proc/point_cloud_xyz reads /fusion/depth/image_rect + /fusion/depth/camera_info
 // (remapped in the .test, nothing else) and publishes /depth_image_proc/points.
-TEST_F(RosConventions, C_DepthImageProcConsumesTheDepthByRemappingOnly) {
+TEST_F(RosConventions, DepthImageProcConsumesTheDepthByRemappingOnly) {
   h().subscribeOutputs({"points2"});
-  Latest<sensor_msgs::PointCloud2> theirs;
+  Latest<sensor_msgs::PointCloud2> theirs, ours_by_stamp;
   theirs.subscribe(nh_, "/depth_image_proc/points");
+  ours_by_stamp.subscribe(nh_, h().output("points2"));
   ASSERT_TRUE(h().outputsConnected());
   ASSERT_TRUE(Harness::waitFor(10.0, [&] { return theirs.sub.getNumPublishers() > 0; }));
-  ros::WallDuration(1.0).sleep();  // point_cloud_xyz subscribes to the depth lazily
-  sensor_msgs::PointCloud2ConstPtr cloud;
-  ros::Time stamp;
-  for (int attempt = 0; attempt < 3 && !cloud; ++attempt) {
-    stamp = h().nextStamp();
-    h().publishSet(SetSpec(), stamp);
-    cloud = theirs.at(stamp);
-  }
-  ASSERT_TRUE(cloud) << "no cloud from depth_image_proc/point_cloud_xyz";
-  ASSERT_TRUE(Harness::waitFor(kOutputTimeout, [&] { return h().count("points2", stamp) > 0; }));
-  const auto ours = h().points();
-  ASSERT_EQ(ours->header.stamp, cloud->header.stamp);
+  // point_cloud_xyz subscribes to the depth lazily, once it has a subscriber.
+  ASSERT_TRUE(Harness::waitFor(10.0, [&] {
+    return lt::hasSubscriber(h().output("depth/image_rect"), kImageProcManager) &&
+           lt::hasSubscriber(h().output("depth/camera_info"), kImageProcManager);
+  })) << "depth_image_proc/point_cloud_xyz does not subscribe to the depth";
+  const ros::Time stamp = publishUntil([&](const ros::Time& t) { return theirs.has(t); });
+  ASSERT_FALSE(stamp.isZero()) << "no cloud from depth_image_proc/point_cloud_xyz";
+  const auto cloud = theirs.at(stamp);
+  const auto ours = ours_by_stamp.at(stamp);
+  ASSERT_TRUE(ours) << "no points2 stamped as depth_image_proc's cloud";
   ASSERT_EQ(cloud->width, ours->width);
   ASSERT_EQ(cloud->height, ours->height);
   EXPECT_EQ(cloud->header.frame_id, ours->header.frame_id);
@@ -199,41 +247,42 @@ TEST_F(RosConventions, C_DepthImageProcConsumesTheDepthByRemappingOnly) {
   int both = 0;
   EXPECT_EQ(differingPoints(*cloud, *ours, &both), 0);
   EXPECT_GT(both, static_cast<int>(cloud->width * cloud->height) / 2);
-  h().unsubscribeOutputs();
 }
 
 // One launch file (ros_conventions.test) runs stereo_image_proc/point_cloud2 twice: /sip_cloud
 // on stereo_image_proc/disparity's output, /ours_cloud on /fusion/disparity; the two differ only
 // in a remap of `disparity`.
-TEST_F(RosConventions, D_StereoImageProcDisparityAndOursSwapByRemappingOnly) {
+TEST_F(RosConventions, StereoImageProcDisparityAndOursSwapByRemappingOnly) {
   h().subscribeOutputs({"points2", "disparity"});
-  Latest<stereo_msgs::DisparityImage> sip_disparity;
-  Latest<sensor_msgs::PointCloud2> sip_cloud, ours_cloud;
+  Latest<stereo_msgs::DisparityImage> sip_disparity, ours_disparity;
+  Latest<sensor_msgs::PointCloud2> sip_cloud, ours_cloud, ours_points;
   sip_disparity.subscribe(nh_, "/sip/disparity");
   sip_cloud.subscribe(nh_, "/sip_cloud/points2");
   ours_cloud.subscribe(nh_, "/ours_cloud/points2");
+  ours_disparity.subscribe(nh_, h().output("disparity"));
+  ours_points.subscribe(nh_, h().output("points2"));
   ASSERT_TRUE(h().outputsConnected());
   ASSERT_TRUE(Harness::waitFor(10.0, [&] {
     return sip_cloud.sub.getNumPublishers() > 0 && ours_cloud.sub.getNumPublishers() > 0 &&
            sip_disparity.sub.getNumPublishers() > 0;
   }));
-  ros::WallDuration(1.0).sleep();
-  ros::Time stamp;
-  sensor_msgs::PointCloud2ConstPtr from_ours, from_sip;
-  for (int attempt = 0; attempt < 3 && !(from_ours && from_sip); ++attempt) {
-    stamp = h().nextStamp();
-    h().publishSet(SetSpec(), stamp);
-    from_ours = ours_cloud.at(stamp);
-    from_sip = sip_cloud.at(stamp, 5.0);
-  }
-  ASSERT_TRUE(from_ours) << "stereo_image_proc/point_cloud2 gave nothing from our disparity";
-  ASSERT_TRUE(from_sip) << "stereo_image_proc/point_cloud2 gave nothing from its own disparity";
+  // The image_pipeline nodelets subscribe to their inputs lazily, once they have a subscriber.
+  ASSERT_TRUE(Harness::waitFor(10.0, [&] {
+    return lt::hasSubscriber(h().output("disparity"), kImageProcManager) &&
+           lt::hasSubscriber("/sip/disparity", kImageProcManager) &&
+           lt::hasSubscriber("/stereo/right/image_rect_color", kImageProcManager);
+  })) << "the stereo_image_proc nodelets do not subscribe to their inputs";
+  const ros::Time stamp =
+      publishUntil([&](const ros::Time& t) { return ours_cloud.has(t) && sip_cloud.has(t); });
+  ASSERT_FALSE(stamp.isZero()) << "stereo_image_proc/point_cloud2 did not give both clouds of a "
+                               << "set (from our disparity: " << ours_cloud.size()
+                               << ", from its own: " << sip_cloud.size() << ")";
+  const auto from_ours = ours_cloud.at(stamp);
+  const auto from_sip = sip_cloud.at(stamp);
   const auto theirs = sip_disparity.at(stamp);
-  ASSERT_TRUE(Harness::waitFor(kOutputTimeout, [&] {
-    return h().count("points2", stamp) > 0 && h().count("disparity", stamp) > 0;
-  }));
-  const auto ours = h().disparity();
-  ASSERT_TRUE(theirs);
+  const auto ours = ours_disparity.at(stamp);
+  const auto points = ours_points.at(stamp);
+  ASSERT_TRUE(theirs && ours && points);
   EXPECT_EQ(ours->image.encoding, theirs->image.encoding);
   EXPECT_EQ(ours->image.width, theirs->image.width);
   EXPECT_EQ(ours->image.height, theirs->image.height);
@@ -244,7 +293,6 @@ TEST_F(RosConventions, D_StereoImageProcDisparityAndOursSwapByRemappingOnly) {
   EXPECT_EQ(from_ours->width, from_sip->width);
   EXPECT_EQ(from_ours->height, from_sip->height);
   // stereo_image_proc's cloud from our disparity holds our points (where both have one).
-  const auto points = h().points();
   int both = 0, far = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(points->width) * points->height; ++i) {
     const cv::Vec3f p = pointAt(*points, i), q = pointAt(*from_ours, i);
@@ -254,13 +302,24 @@ TEST_F(RosConventions, D_StereoImageProcDisparityAndOursSwapByRemappingOnly) {
   }
   EXPECT_GT(both, static_cast<int>(points->width * points->height) / 2);
   EXPECT_EQ(far, 0);
-  h().unsubscribeOutputs();
 }
 
-TEST_F(RosConventions, E_DynparamRefusalsAreVisibleAndTheValueInForceIsShown) {
+/// `dynparam` of the system Python (a pyenv or conda python3 first on PATH cannot import rospy).
+const char* const kDynparam = "/usr/bin/python3 /usr/lib/dynamic_reconfigure/dynparam";
+
+/// Sets the node's window_radius back to its default when a test ends, however it ends.
+struct RestoreWindowRadius {
+  std::string node;
+  ~RestoreWindowRadius() {
+    lt::runCommand(std::string(kDynparam) + " set " + node + " window_radius " +
+                   std::to_string(lidar_stereo_fusion::PatchMatchParams().window_radius));
+  }
+};
+
+TEST_F(RosConventions, DynparamRefusalsAreVisibleAndTheValueInForceIsShown) {
   const std::string node = h().fusionNode();
-  // The system Python (a pyenv or conda python3 first on PATH cannot import rospy).
-  const std::string dynparam = "/usr/bin/python3 /usr/lib/dynamic_reconfigure/dynparam";
+  const std::string dynparam = kDynparam;
+  const RestoreWindowRadius restore{node};
   const auto get = [&] { return lt::runCommand(dynparam + " get " + node).second; };
   const std::string window =
       "'window_radius': " + std::to_string(lidar_stereo_fusion::PatchMatchParams().window_radius);
@@ -297,8 +356,6 @@ TEST_F(RosConventions, E_DynparamRefusalsAreVisibleAndTheValueInForceIsShown) {
     if (name.rfind(node + "/", 0) != 0) continue;
     EXPECT_EQ(name.find("patchmatch"), std::string::npos) << name << ": a second spelling";
   }
-  std::tie(status, out) = lt::runCommand(dynparam + " set " + node + " window_radius 8");
-  EXPECT_EQ(status, 0) << out;
 }
 
 int main(int argc, char** argv) {
