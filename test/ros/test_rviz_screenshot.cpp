@@ -1,7 +1,8 @@
 // rostest: RViz with rviz/fusion.rviz, on a virtual X server (Xvfb), draws the fused cloud.
 //
 // The test publishes one frame of the simulated street again and again (so that the picture is
-// still) in two phases and takes a screenshot of each with ImageMagick's `import`:
+// still) in two phases and takes a screenshot of each with ImageMagick's `import`, once the
+// picture has settled (two screenshots in a row agree):
 //   A  images and LiDAR sweeps stamped half a period apart: no sweep matches (max_time_offset), so
 //      the fusion publishes nothing, while RViz draws the raw LiDAR points;
 //   B  sweeps stamped like the images: the fusion publishes points2, which RViz adds.
@@ -20,7 +21,6 @@
 #include <cstring>
 #include <functional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -41,6 +41,7 @@ namespace lsf = lidar_stereo_fusion;
 namespace {
 
 constexpr int kScreenWidth = 1600, kScreenHeight = 1000;
+constexpr const char* kFusionProcess = "/fusion/fusion_manager";  ///< fusion.launch's manager
 const cv::Vec3b kBackground(48, 48, 48);  ///< Global Options / Background Color of fusion.rviz
 
 using lsf::test::Child;
@@ -50,7 +51,8 @@ using lsf::test::onPath;
 using lsf::test::run;
 using lsf::test::waitFor;
 
-/// Publishes frame 0 of the street at 2 Hz from a thread; the sweep stamp offset can change.
+/// Publishes frame 0 of the street at 2 Hz (a wall timer on the spinner's threads); the sweep
+/// stamp offset can change. Counts the sets it published, so that a test waits for sets, not time.
 class Publisher {
  public:
   explicit Publisher(const lsf::sim::SyntheticFrame& frame) : frame_(frame) {
@@ -63,29 +65,29 @@ class Publisher {
                                          lsf::test::kLidarFrame);
     tf.header.stamp = ros::Time::now();
     tf_.sendTransform(tf);
-    thread_ = std::thread([this] { loop(); });
+    timer_ = nh_.createWallTimer(ros::WallDuration(0.5),
+                                 [this](const ros::WallTimerEvent&) { publishSet(); });
   }
-  ~Publisher() {
-    stop_ = true;
-    thread_.join();
-  }
+  ~Publisher() { timer_.stop(); }
   void setSweepOffset(double seconds) { sweep_offset_ = seconds; }
+  /// Waits until `n` more sets have been published; false after `timeout` [s].
+  bool waitForSets(int n, double timeout = 10.0) {
+    const int target = published_ + n;
+    return waitFor(timeout, [&] { return published_ >= target; });
+  }
 
  private:
-  void loop() {
+  void publishSet() {
     using lsf::test::kCameraFrame;
     using lsf::test::kRightCameraFrame;
-    ros::WallRate rate(2.0);
-    while (!stop_ && ros::ok()) {
-      const ros::Time stamp = ros::Time::now();
-      left_info_.publish(lsf::test::cameraInfoMsg(frame_.camera, false, kCameraFrame, stamp));
-      right_info_.publish(lsf::test::cameraInfoMsg(frame_.camera, true, kRightCameraFrame, stamp));
-      left_image_.publish(lsf::test::imageMsg(frame_.left, "bgr8", kCameraFrame, stamp));
-      right_image_.publish(lsf::test::imageMsg(frame_.right, "bgr8", kRightCameraFrame, stamp));
-      cloud_.publish(lsf::test::cloudMsg(frame_.cloud, lsf::test::kLidarFrame,
-                                         stamp + ros::Duration(sweep_offset_.load())));
-      rate.sleep();
-    }
+    const ros::Time stamp = ros::Time::now();
+    left_info_.publish(lsf::test::cameraInfoMsg(frame_.camera, false, kCameraFrame, stamp));
+    right_info_.publish(lsf::test::cameraInfoMsg(frame_.camera, true, kRightCameraFrame, stamp));
+    left_image_.publish(lsf::test::imageMsg(frame_.left, "bgr8", kCameraFrame, stamp));
+    right_image_.publish(lsf::test::imageMsg(frame_.right, "bgr8", kRightCameraFrame, stamp));
+    cloud_.publish(lsf::test::cloudMsg(frame_.cloud, lsf::test::kLidarFrame,
+                                       stamp + ros::Duration(sweep_offset_.load())));
+    ++published_;
   }
 
   const lsf::sim::SyntheticFrame& frame_;
@@ -93,8 +95,8 @@ class Publisher {
   ros::Publisher left_image_, left_info_, right_image_, right_info_, cloud_;
   tf2_ros::StaticTransformBroadcaster tf_;
   std::atomic<double> sweep_offset_{0.25};
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
+  std::atomic<int> published_{0};
+  ros::WallTimer timer_;
 };
 
 /// RViz's 3D view: the longest run of columns, then of rows within them, in which at least a
@@ -153,6 +155,26 @@ double changedFraction(const cv::Mat3b& a, const cv::Mat3b& b, const cv::Rect& b
   return box.area() > 0 ? static_cast<double>(changed) / box.area() : 0.0;
 }
 
+/// Screenshots of `display` into `path`, one after each new input set, until two in a row differ
+/// in under 1 % of the screen's pixels: RViz has drawn what it received. False after `timeout` [s].
+bool settledShot(const std::string& display, const std::string& path, Publisher& publisher,
+                 double timeout = 60.0) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout);
+  cv::Mat3b previous;
+  while (std::chrono::steady_clock::now() < end) {
+    if (!publisher.waitForSets(1) || run({"import", "-window", "root", path}, display) != 0) {
+      return false;
+    }
+    const cv::Mat3b shot = cv::imread(path, cv::IMREAD_COLOR);
+    if (!shot.empty() && shot.size() == previous.size() &&
+        changedFraction(previous, shot, cv::Rect(0, 0, shot.cols, shot.rows)) < 0.01) {
+      return true;
+    }
+    previous = shot;
+  }
+  return false;
+}
+
 /// Fraction of the pixels in `box` of a strong colour (HSV saturation > 150 and value > 80 of
 /// 255): the colour maps of depth and disparity, not grey panels or the background.
 double colourfulFraction(const cv::Mat3b& image, const cv::Rect& box) {
@@ -207,22 +229,24 @@ TEST(RvizScreenshot, FusedCloudIsDrawn) {
       << "RViz did not subscribe (see " << out_dir << "/rviz_test_rviz.log)";
   ASSERT_TRUE(rviz.running());
 
-  // Phase A: raw LiDAR only; the fusion finds no sweep within max_time_offset.
-  ros::WallDuration(8.0).sleep();
-  const int fused_in_a = fused;
+  // Phase A: raw LiDAR only; the fusion finds no sweep within max_time_offset. It has its inputs
+  // (RViz subscribes to its outputs) and four sets to match; RViz's picture settles.
+  ASSERT_TRUE(waitFor(30.0, [&] { return hasSubscriber("/velodyne_points", kFusionProcess); }))
+      << "the fusion did not subscribe to its inputs";
+  ASSERT_TRUE(publisher.waitForSets(4));
   const std::string shot_a = out_dir + "/rviz_phase_a.png",
                     shot_a2 = out_dir + "/rviz_phase_a2.png";
-  ASSERT_EQ(run({"import", "-window", "root", shot_a}, display), 0);
-  ros::WallDuration(1.5).sleep();
+  ASSERT_TRUE(settledShot(display, shot_a, publisher)) << "RViz's picture does not settle";
+  const int fused_in_a = fused;
+  ASSERT_TRUE(publisher.waitForSets(3));  // the picture stays as it is: a second shot later
   ASSERT_EQ(run({"import", "-window", "root", shot_a2}, display), 0);
   EXPECT_EQ(fused_in_a, 0) << "the fusion published although no sweep matched";
 
-  // Phase B: sweeps match; the fused cloud appears.
+  // Phase B: sweeps match; the fused cloud appears, and RViz's picture settles again.
   publisher.setSweepOffset(0.0);
   ASSERT_TRUE(waitFor(60.0, [&] { return fused >= 2; })) << "no fused cloud published";
-  ros::WallDuration(4.0).sleep();
   const std::string shot_b = out_dir + "/rviz_fusion.png";
-  ASSERT_EQ(run({"import", "-window", "root", shot_b}, display), 0);
+  ASSERT_TRUE(settledShot(display, shot_b, publisher)) << "RViz's picture does not settle";
   EXPECT_TRUE(rviz.running()) << "RViz died";
 
   const cv::Mat3b a = cv::imread(shot_a, cv::IMREAD_COLOR);
