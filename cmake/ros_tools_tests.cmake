@@ -52,7 +52,7 @@ if(TARGET kitti_runner)
   lsf_add_tools_rostest(test_kitti_bag test/ros/kitti_bag.test
     SOURCES test/ros/test_kitti_bag.cpp test/ros/test_kitti_bag_replay.cpp
             test/ros/kitti_bag_expected.cpp test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
-            test/ros/depth_agreement.cpp test/ros/bag_runner_check.cpp
+            test/ros/depth_agreement.cpp test/ros/bag_runner_check.cpp test/ros/child_process.cpp
     DEPENDS kitti_to_bag kitti_runner bag_runner ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
   target_include_directories(test_kitti_bag SYSTEM PRIVATE
     ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})  # FusionStats.h
@@ -61,8 +61,10 @@ if(TARGET kitti_runner)
     LSF_BAG_RUNNER="$<TARGET_FILE:bag_runner>")
   lsf_add_tools_rostest(test_kitti_bag_rates test/ros/kitti_bag_rates.test
     SOURCES test/ros/test_kitti_bag_rates.cpp test/ros/kitti_bag_expected.cpp
-            test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
-    DEPENDS kitti_to_bag ${PROJECT_NAME}_ros)
+            test/ros/kitti_bag_util.cpp test/ros/run_command.cpp test/ros/child_process.cpp
+    DEPENDS kitti_to_bag ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
+  target_include_directories(test_kitti_bag_rates SYSTEM PRIVATE
+    ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION})  # FusionStats.h
   target_compile_definitions(test_kitti_bag_rates PRIVATE
     LSF_KITTI_TO_BAG="$<TARGET_FILE:kitti_to_bag>")
   # kitti_to_bag --period / --cycles: stamps of the restamped, repeated stream (no ROS master).
@@ -85,6 +87,7 @@ if(TARGET kitti_runner)
   # Issue 26: pcl_ros's CropBox (sweep) and VoxelGrid (points2) in the fusion's manager.
   lsf_add_tools_rostest(test_pcl_filters test/ros/pcl_filters.test
     SOURCES test/ros/test_pcl_filters.cpp test/ros/kitti_bag_util.cpp test/ros/run_command.cpp
+            test/ros/child_process.cpp
     DEPENDS kitti_to_bag ${PROJECT_NAME}_ros ${PROJECT_NAME}_generate_messages_cpp)
   target_include_directories(test_pcl_filters SYSTEM PRIVATE
     ${CATKIN_DEVEL_PREFIX}/${CATKIN_GLOBAL_INCLUDE_DESTINATION} ${PCL_INCLUDE_DIRS}

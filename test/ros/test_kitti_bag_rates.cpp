@@ -28,9 +28,11 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "child_process.h"
 #include "data/data_guard.h"
 #include "kitti_bag_expected.h"
 #include "kitti_bag_util.h"
+#include "lidar_stereo_fusion/FusionStats.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 
 namespace fs = std::filesystem;
@@ -63,11 +65,28 @@ void writeShiftedBag(const std::string& in, const std::string& out, const ros::D
   }
 }
 
-/// Depth and confidence images received, keyed by stamp.
+/// Depth and confidence images received, keyed by stamp, and the node's count of processed frames
+/// at each stamp (FusionStats::processed_frames).
 struct Collector {
   std::mutex mutex;
   std::condition_variable cv;
   std::map<ros::Time, std::vector<sensor_msgs::ImageConstPtr>> depth, confidence;
+  std::map<ros::Time, uint32_t> processed;
+
+  void addStats(const lidar_stereo_fusion::FusionStatsConstPtr& msg) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      processed[msg->header.stamp] = msg->processed_frames;
+    }
+    cv.notify_all();
+  }
+  /// Messages of `store` received in total.
+  static std::size_t count(
+      const std::map<ros::Time, std::vector<sensor_msgs::ImageConstPtr>>& store) {
+    std::size_t n = 0;
+    for (const auto& [stamp, msgs] : store) n += msgs.size();
+    return n;
+  }
 
   void add(std::map<ros::Time, std::vector<sensor_msgs::ImageConstPtr>>& store,
            const sensor_msgs::ImageConstPtr& msg) {
@@ -136,6 +155,13 @@ TEST(KittiBagRates, EveryPublishedDepthIsItsOwnFramesAtAnyPlaybackRate) {
       "depth/image_rect", 10, [&](const sensor_msgs::ImageConstPtr& m) { got.add(got.depth, m); });
   auto confidence_sub = nh.subscribe<sensor_msgs::Image>(
       "confidence", 10, [&](const sensor_msgs::ImageConstPtr& m) { got.add(got.confidence, m); });
+  auto stats_sub = nh.subscribe<lidar_stereo_fusion::FusionStats>(
+      "stats", 10, [&](const lidar_stereo_fusion::FusionStatsConstPtr& m) { got.addStats(m); });
+  // Connected before the first frame: every processed frame's outputs reach the collector.
+  ASSERT_TRUE(lt::waitFor(30.0, [&] {
+    return depth_sub.getNumPublishers() > 0 && confidence_sub.getNumPublishers() > 0 &&
+           stats_sub.getNumPublishers() > 0;
+  })) << "the fusion's outputs are not advertised";
 
   const std::vector<double> rates = {0.1, 0.5, 1.0};
   for (size_t r = 0; r < rates.size(); ++r) {
@@ -144,22 +170,27 @@ TEST(KittiBagRates, EveryPublishedDepthIsItsOwnFramesAtAnyPlaybackRate) {
     const ros::Duration shift(1000.0 * static_cast<double>(r));
     const std::string shifted = scratch + "/shifted_" + std::to_string(r) + ".bag";
     writeShiftedBag(bag_path, shifted, shift);
-    // -d 3: after advertising, time for the nodelet (subscribed lazily via our depth subscriber)
-    // to connect before the first message.
+    // --wait-for-subscribers: the first message only once the nodelet (subscribed lazily via our
+    // subscribers) has connected to every topic of the bag.
     const auto [play_status, play_output] =
-        lt::runCommand("rosbag play --clock -q -d 3 -r " + std::to_string(rate) + " " + shifted);
+        lt::runCommand("timeout 300 rosbag play --clock -q --wait-for-subscribers -r " +
+                       std::to_string(rate) + " " + shifted);
     ASSERT_EQ(play_status, 0) << play_output;
     fs::remove(shifted);
     // The last set is decided when its sweep arrives (the bag's last message); wait for the
-    // worker to publish it.
+    // worker to publish it, and for the depth and confidence of every frame the node says it
+    // processed (its stats of that set) to have arrived here: then no output of this bag is still
+    // on its way.
     const ros::Time last = stamps.back() + shift;
-    {
-      std::unique_lock<std::mutex> lock(got.mutex);
-      got.cv.wait_for(lock, std::chrono::seconds(120), [&] { return got.depth.count(last) > 0; });
-    }
-    ros::WallDuration(1.0).sleep();
-
-    std::lock_guard<std::mutex> lock(got.mutex);
+    std::unique_lock<std::mutex> lock(got.mutex);
+    const bool all_arrived = got.cv.wait_for(lock, std::chrono::seconds(120), [&] {
+      return got.processed.count(last) > 0 && got.count(got.depth) >= got.processed.at(last) &&
+             got.count(got.confidence) >= got.processed.at(last);
+    });
+    ASSERT_TRUE(all_arrived) << "the stats of the last frame, or the depth or confidence of a "
+                             << "processed frame, did not arrive";
+    EXPECT_EQ(got.count(got.depth), got.processed.at(last)) << "a depth without a frame";
+    EXPECT_EQ(got.count(got.confidence), got.processed.at(last)) << "a confidence without a frame";
     int published = 0;
     for (size_t i = 0; i < stamps.size(); ++i) {
       const ros::Time t = stamps[i] + shift;
