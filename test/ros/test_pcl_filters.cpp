@@ -36,6 +36,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "child_process.h"
 #include "data/data_guard.h"
 #include "kitti_bag_util.h"
 #include "lidar_stereo_fusion/FusionStats.h"
@@ -218,13 +219,12 @@ TEST(PclFilters, CropBoxAndVoxelGridInTheFusionsManager) {
     }
     return got.connected();
   };
-  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(60.0);
-  while (!connected() && ros::WallTime::now() < give_up) ros::WallDuration(0.1).sleep();
-  ASSERT_TRUE(connected()) << "the fusion and the pcl_ros filters did not connect";
+  ASSERT_TRUE(lt::waitFor(60.0, connected)) << "the fusion and the pcl_ros filters did not connect";
 
   std::printf(
       "frame       | CropBox in test [ms] | VoxelGrid in test [ms] | fusion total_ms | "
       "sweep -> filtered [ms] | points2 -> voxel [ms] | points2 / voxel points\n");
+  ros::Time last_stamp;
   for (size_t i = 0; i < kFrames.size(); ++i) {
     SCOPED_TRACE("frame " + kFrames[i]);
     const auto sweep = topics["/velodyne_points"][i].instantiate<Cloud>();
@@ -247,6 +247,7 @@ TEST(PclFilters, CropBoxAndVoxelGridInTheFusionsManager) {
         topics["/stereo/right/image_rect_color"][i].instantiate<sensor_msgs::Image>());
     in["/stereo/left/image_rect_color"].publish(left);
     const ros::Time t = left->header.stamp;
+    last_stamp = t;
     ASSERT_TRUE(got.waitFor(
         [&] {
           return got.at(got.stats_, t) && got.at(got.prior_, t) && got.at(got.points_, t) &&
@@ -279,8 +280,17 @@ TEST(PclFilters, CropBoxAndVoxelGridInTheFusionsManager) {
                 (filtered.second - sent) * 1e3, (voxel.second - points.second) * 1e3, points_n,
                 voxel_n);
   }
-  ros::WallDuration(1.0).sleep();  // a late extra message would arrive now
+  // The node processed each frame once, and no extra cloud follows the last frame's (a topic
+  // delivers in order: one of an earlier frame would have come before).
+  EXPECT_FALSE(got.waitFor(
+      [&] {
+        return got.points_.messages.size() > kFrames.size() ||
+               got.voxel_.messages.size() > kFrames.size();
+      },
+      1.0))
+      << "an extra points2 or voxel cloud";
   std::lock_guard<std::mutex> lock(got.mutex_);
+  EXPECT_EQ(got.at(got.stats_, last_stamp)->first->processed_frames, kFrames.size());
   EXPECT_EQ(got.points_.messages.size(), kFrames.size());
   EXPECT_EQ(got.voxel_.messages.size(), got.points_.messages.size())
       << "the voxel cloud comes at the rate of points2";
