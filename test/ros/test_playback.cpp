@@ -11,7 +11,9 @@
 // Missing data fails under CI=true and skips otherwise.
 #include <signal.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -56,6 +58,11 @@ std::string bagPath() {
   path = bag;
   return path;
 }
+
+/// The launch's `bag` argument that makes the player wait for a subscriber on each of the bag's
+/// topics (the fusion, subscribed lazily via the test's own subscribers) instead of a fixed delay:
+/// `bag` ends the player's arguments.
+std::string playWhenSubscribed(const std::string& bag) { return "--wait-for-subscribers " + bag; }
 
 /// roslaunch lidar_stereo_fusion playback.launch <args>, ended with SIGINT (as Ctrl-C).
 std::unique_ptr<lt::Child> startPlayback(const std::vector<std::string>& args,
@@ -124,20 +131,31 @@ TEST(Playback, AtTheEndOfTheBagTheFusionAndRvizStay) {
   std::atomic<int> clouds{0};
   auto sub = nh.subscribe<sensor_msgs::PointCloud2>(
       "/fusion/points2", 2, [&](const sensor_msgs::PointCloud2ConstPtr&) { ++clouds; });
-  // A long delay: RViz (software rendering) is up and subscribed before the bag plays.
-  auto launch = startPlayback({"bag:=" + bag, "rviz:=true", "delay:=15"}, display,
-                              out_dir + "/playback_test_end.log");
+  auto launch = startPlayback({"bag:=" + playWhenSubscribed(bag), "rviz:=true", "delay:=0"},
+                              display, out_dir + "/playback_test_end.log");
   ASSERT_TRUE(lt::waitFor(90.0, [] { return lt::nodeRegistered("/player"); }))
       << "no player (see " << out_dir << "/playback_test_end.log)";
   ASSERT_TRUE(lt::waitFor(120.0, [] { return !lt::nodeRegistered("/player"); }))
       << "the bag did not end";
+  const auto bag_end = std::chrono::steady_clock::now();
   std::printf("bag ended; %d fused clouds so far\n", clouds.load());
   // RViz may still be starting on a slow machine: wait for it (a required player would have ended
-  // the whole launch by now, RViz with it), then give the end of the bag time to end anything.
+  // the whole launch by now, RViz with it).
   EXPECT_TRUE(lt::waitFor(90.0, [] {
     return lt::nodeRegistered("/rviz") && lt::hasSubscriber("/fusion/points2", "/rviz");
   })) << "no RViz subscribed to the fused cloud after the end of the bag";
-  ros::WallDuration(8.0).sleep();
+  // ROS time stopped with the bag. The fusion checks its inputs every second of wall time: until
+  // ~input_timeout and two checks of wall time have passed since the bag ended, nothing may end
+  // and no warning may call the stopped bag a silent driver.
+  double input_timeout = 5.0;
+  ros::param::get("/fusion/fusion/input_timeout", input_timeout);
+  const double since_end =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - bag_end).count();
+  EXPECT_FALSE(lt::waitFor(std::max(0.0, input_timeout + 2.0 - since_end), [&] {
+    return !launch->running() || !lt::nodeRegistered("/fusion/fusion_manager") ||
+           !lt::nodeRegistered("/rviz") || !warnings.containing("nothing received").empty() ||
+           !warnings.containing("no publisher").empty();
+  })) << "something ended, or a warning came, after the end of the bag";
   EXPECT_TRUE(launch->running()) << "roslaunch ended with the bag";
   EXPECT_TRUE(lt::nodeRegistered("/fusion/fusion_manager"));
   EXPECT_TRUE(lt::nodeRegistered("/rviz")) << "RViz closed at the end of the bag";
@@ -197,7 +215,8 @@ TEST(Playback, LoopedBagKeepsLatencyPositiveAndDiagnosticsFlowing) {
         }
       });
   const std::string log = std::string(LSF_BINARY_DIR) + "/playback_test_loop.log";
-  auto launch = startPlayback({"bag:=" + bag, "rviz:=false", "loop:=true"}, "", log);
+  auto launch = startPlayback(
+      {"bag:=" + playWhenSubscribed(bag), "rviz:=false", "loop:=true", "delay:=0"}, "", log);
   const auto locked = [&](auto f) {
     std::lock_guard<std::mutex> lock(mutex);
     return f();
