@@ -56,7 +56,7 @@ Options:
 struct Options {
   std::string data, params, ip_basic_blur = "gaussian";
   std::set<std::string> methods, layouts;
-  bool middlebury = true, kitti = true, dense = true, kitti_pms = true, help = false;
+  bool middlebury = true, kitti = true, dense = true, kitti_pms = true;
   int frames = 0;
 };
 
@@ -86,9 +86,8 @@ Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(argc, argv,
                             {"--data", "--protocols", "--layouts", "--frames", "--params",
                              "--methods", "--ip-basic-blur"},
-                            {"--no-kitti-pms", "--help"});
+                            {"--no-kitti-pms"});
   Options o;
-  o.help = cl.has("--help");
   o.data = cl.value("--data", defaultDataDir());
   o.frames = cl.intValue("--frames", 0, 1, 1000);
   o.kitti_pms = !cl.has("--no-kitti-pms");
@@ -122,7 +121,7 @@ Options parseOptions(int argc, char** argv) {
   o.middlebury = o.middlebury && anyChosen(o.layouts, lsf::middleburyLayoutNames());
   o.kitti = o.kitti && anyChosen(o.layouts, lsf::kittiLayoutNames());
   o.dense = o.dense && anyChosen(o.layouts, lsf::denseLayoutNames());
-  if (!o.help && !o.middlebury && !o.kitti && !o.dense) {
+  if (!o.middlebury && !o.kitti && !o.dense) {
     throw lsf::UsageError(
         "--protocols and --layouts leave nothing to run (no chosen layout "
         "belongs to a chosen protocol)");
@@ -213,21 +212,6 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options o;
-  try {
-    o = parseOptions(argc, argv);
-  } catch (const lsf::UsageError& e) {
-    std::cerr << "accuracy_report: " << e.what() << "\n\n" << kUsage;
-    return 2;
-  }
-  if (o.help) {
-    std::cout << kUsage;
-    return 0;
-  }
-  try {
-    return run(o);
-  } catch (const std::exception& e) {
-    std::cerr << "accuracy_report: " << e.what() << "\n";
-    return 1;
-  }
+  return lsf::toolMain("accuracy_report", kUsage, argc, argv,
+                       [&] { return run(parseOptions(argc, argv)); });
 }

@@ -68,7 +68,7 @@ double timeMs(const std::function<void()>& f) {
 struct Options {
   std::string drive, frame, method, params, synthetic;
   int repeat = 5, threads = 0, rings = 64;
-  bool help = false, sgbm = true;
+  bool sgbm = true;
 };
 
 std::string defaultDrive() {
@@ -81,9 +81,8 @@ Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(argc, argv,
                             {"--kitti-raw", "--frame", "--repeat", "--method", "--threads",
                              "--params", "--synthetic", "--rings"},
-                            {"--help", "--no-sgbm"});
+                            {"--no-sgbm"});
   Options o;
-  o.help = cl.has("--help");
   o.sgbm = !cl.has("--no-sgbm");
   o.drive = cl.value("--kitti-raw", defaultDrive());
   o.frame = cl.value("--frame");
@@ -259,24 +258,6 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options options;
-  try {
-    options = parseOptions(argc, argv);
-  } catch (const lsf::UsageError& e) {
-    std::cerr << "fusion_benchmark: " << e.what() << "\n\n" << kUsage;
-    return 2;
-  }
-  if (options.help) {
-    std::cout << kUsage;
-    return 0;
-  }
-  try {
-    return run(options);
-  } catch (const lsf::UsageError& e) {
-    std::cerr << "fusion_benchmark: " << e.what() << "\n\n" << kUsage;
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "fusion_benchmark: error: " << e.what() << "\n";
-    return 1;
-  }
+  return lsf::toolMain("fusion_benchmark", kUsage, argc, argv,
+                       [&] { return run(parseOptions(argc, argv)); });
 }

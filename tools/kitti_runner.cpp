@@ -102,9 +102,8 @@ Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(
       argc, argv,
       {"--kitti-raw", "--out", "--method", "--params", "--reference", "--frames", "--holdout"},
-      {"--save-vis", "--save-pcd", "--deskew", "--photometric-check", "--help"});
+      {"--save-vis", "--save-pcd", "--deskew", "--photometric-check"});
   Options o;
-  if (cl.has("--help")) return o;
   o.drive = cl.value("--kitti-raw");
   o.out = cl.value("--out");
   if (o.drive.empty()) throw lsf::UsageError("--kitti-raw is required");
@@ -350,21 +349,6 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options options;
-  try {
-    options = parseOptions(argc, argv);
-  } catch (const lsf::UsageError& e) {
-    std::cerr << "kitti_runner: " << e.what() << "\n\n" << kUsage;
-    return 2;
-  }
-  if (options.drive.empty()) {  // --help
-    std::cout << kUsage;
-    return 0;
-  }
-  try {
-    return run(options);
-  } catch (const std::exception& e) {
-    std::cerr << "\nkitti_runner: error: " << e.what() << "\n";
-    return 1;
-  }
+  return lsf::toolMain("kitti_runner", kUsage, argc, argv,
+                       [&] { return run(parseOptions(argc, argv)); });
 }

@@ -19,6 +19,7 @@
 
 #include "lidar_stereo_fusion/core/metrics.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/sim/kitti_export.h"
 #include "lidar_stereo_fusion/sim/synthetic_frame.h"
@@ -35,21 +36,20 @@ using lsf_demo::kFastWidth;
 using lsf_demo::MethodRun;
 using lsf_demo::secondsSince;
 
-void printUsage() {
-  std::cout
-      << "Usage:\n"
-         "  lsf_demo [--out DIR] [--seed N] [--fast] [--rings 64|128] [--methods a,b,...]\n"
-         "      synthetic street with exact ground truth (default)\n"
-         "  lsf_demo --kitti [DRIVE_DIR] [--frame NAME] [--out DIR] [--fast] [--methods ...]\n"
-         "      the KITTI sample, scored on held-out LiDAR rings (even rings in, odd rings out)\n"
-         "  lsf_demo --generate DIR [--seed N] [--frames N] [--rings 64|128] [--fast]\n"
-         "      writes the synthetic street in the KITTI raw layout (+ exact depth PNGs)\n"
-         "Options:\n"
-         "  --out DIR      pictures go here (default ./demo_output)\n"
-         "  --seed N       scene seed (default 1)\n"
-         "  --fast         half-size images (620x188) for a quick look\n"
-         "  --methods L    comma-separated subset of fused_bi,fused_bf,lidar_bi,lidar_bf,pms\n";
-}
+const char* const kUsage = R"(Usage:
+  lsf_demo [--out DIR] [--seed N] [--fast] [--rings 64|128] [--methods a,b,...]
+      synthetic street with exact ground truth (default)
+  lsf_demo --kitti [DRIVE_DIR] [--frame NAME] [--out DIR] [--fast] [--methods ...]
+      the KITTI sample, scored on held-out LiDAR rings (even rings in, odd rings out)
+  lsf_demo --generate DIR [--seed N] [--frames N] [--rings 64|128] [--fast]
+      writes the synthetic street in the KITTI raw layout (+ exact depth PNGs)
+Options:
+  --out DIR      pictures go here (default ./demo_output)
+  --seed N       scene seed (default 1)
+  --fast         half-size images (620x188) for a quick look
+  --methods L    comma-separated subset of fused_bi,fused_bf,lidar_bi,lidar_bf,pms
+  --help         this text
+)";
 
 struct Options {
   enum class Mode { kSynthetic, kKitti, kGenerate } mode = Mode::kSynthetic;
@@ -71,9 +71,14 @@ std::vector<lsf::Method> parseMethods(const std::string& list) {
   std::stringstream in(list);
   std::string name;
   while (std::getline(in, name, ',')) {
-    if (!name.empty()) methods.push_back(lsf::parseMethod(name));
+    if (name.empty()) continue;
+    try {
+      methods.push_back(lsf::parseMethod(name));
+    } catch (const std::invalid_argument& e) {
+      throw lsf::UsageError(std::string("--methods: ") + e.what());
+    }
   }
-  if (methods.empty()) throw std::invalid_argument("--methods needs at least one method");
+  if (methods.empty()) throw lsf::UsageError("--methods needs at least one method");
   return methods;
 }
 
@@ -86,8 +91,8 @@ long parseInteger(const std::string& text, const std::string& flag, long lo, lon
     used = 0;
   }
   if (used != text.size() || value < lo || value > hi) {
-    throw std::invalid_argument(flag + " needs an integer in [" + std::to_string(lo) + ", " +
-                                std::to_string(hi) + "], got '" + text + "'");
+    throw lsf::UsageError(flag + " needs an integer in [" + std::to_string(lo) + ", " +
+                          std::to_string(hi) + "], got '" + text + "'");
   }
   return value;
 }
@@ -100,13 +105,10 @@ Options parseOptions(int argc, char** argv) {
     const bool has_next = i + 1 < args.size();
     const bool next_is_value = has_next && args[i + 1].rfind("--", 0) != 0;
     auto value = [&]() -> const std::string& {
-      if (!next_is_value) throw std::invalid_argument(a + " needs a value");
+      if (!next_is_value) throw lsf::UsageError(a + " needs a value");
       return args[++i];
     };
-    if (a == "--help" || a == "-h") {
-      printUsage();
-      std::exit(0);
-    } else if (a == "--kitti") {
+    if (a == "--kitti") {
       o.mode = Options::Mode::kKitti;
       if (next_is_value) o.kitti_dir = args[++i];
     } else if (a == "--generate") {
@@ -127,9 +129,10 @@ Options parseOptions(int argc, char** argv) {
     } else if (a == "--fast") {
       o.fast = true;
     } else {
-      throw std::invalid_argument("unknown argument '" + a + "' (try --help)");
+      throw lsf::UsageError("unknown argument '" + a + "'");
     }
   }
+  if (o.rings != 64 && o.rings != 128) throw lsf::UsageError("--rings must be 64 or 128");
   return o;
 }
 
@@ -245,13 +248,8 @@ int runDemo(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return lsf::toolMain("lsf_demo", kUsage, argc, argv, [&] {
     const Options o = parseOptions(argc, argv);
-    if (o.rings != 64 && o.rings != 128) throw std::invalid_argument("--rings must be 64 or 128");
-    if (o.mode == Options::Mode::kGenerate) return generate(o);
-    return runDemo(o);
-  } catch (const std::exception& e) {
-    std::cerr << "lsf_demo: " << e.what() << "\n";
-    return 1;
-  }
+    return o.mode == Options::Mode::kGenerate ? generate(o) : runDemo(o);
+  });
 }

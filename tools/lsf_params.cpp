@@ -10,6 +10,7 @@
 #include <iostream>
 #include <string>
 
+#include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/text_file.h"
 #include "lidar_stereo_fusion/ros/param_files.h"
 
@@ -35,8 +36,7 @@ int print(const std::string& which) {
     std::cout << file.contents;
     return 0;
   }
-  std::cerr << "lsf_params: " << which << " is not a generated file\n" << kUsage;
-  return 2;
+  throw lidar_stereo_fusion::UsageError(which + " is not a generated file");
 }
 
 /// --check: names every stale file; --write: rewrites them. 1 when a file is stale (check) or
@@ -66,20 +66,23 @@ int checkOrWrite(bool write, const std::string& dir) {
   return failed > 0 ? 1 : 0;
 }
 
+/// The mode and its folder or file from the command line; UsageError when they do not fit.
+int run(int argc, char** argv) {
+  const std::string mode = argc > 1 ? argv[1] : "";
+  if (mode != "--check" && mode != "--write" && mode != "--print") {
+    throw lidar_stereo_fusion::UsageError(mode.empty() ? "no mode" : "unknown mode '" + mode + "'");
+  }
+  if (argc > 3 || (mode == "--print" && argc != 3)) {
+    throw lidar_stereo_fusion::UsageError(mode == "--print" ? "--print takes one PATH"
+                                                            : mode + " takes at most a folder");
+  }
+  if (mode == "--print") return print(argv[2]);
+  return checkOrWrite(mode == "--write", argc > 2 ? argv[2] : LSF_SOURCE_DIR);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string mode = argc > 1 ? argv[1] : "";
-  if ((mode != "--check" && mode != "--write" && mode != "--print") || argc > 3 ||
-      (mode == "--print" && argc != 3)) {
-    std::cerr << kUsage;
-    return 2;
-  }
-  try {
-    if (mode == "--print") return print(argv[2]);
-    return checkOrWrite(mode == "--write", argc > 2 ? argv[2] : LSF_SOURCE_DIR);
-  } catch (const std::exception& e) {
-    std::cerr << "lsf_params: " << e.what() << "\n";
-    return 1;
-  }
+  return lidar_stereo_fusion::toolMain("lsf_params", kUsage, argc, argv,
+                                       [&] { return run(argc, argv); });
 }

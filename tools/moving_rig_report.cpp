@@ -61,13 +61,8 @@ std::vector<double> numbers(const std::string& option, const std::string& text, 
 }
 
 int run(int argc, char** argv) {
-  const lsf::CommandLine cl(argc, argv,
-                            {"--size", "--rings", "--speeds", "--offsets", "--methods", "--frames"},
-                            {"--help"});
-  if (cl.has("--help")) {
-    std::cout << kUsage;
-    return 0;
-  }
+  const lsf::CommandLine cl(
+      argc, argv, {"--size", "--rings", "--speeds", "--offsets", "--methods", "--frames"}, {});
   int w = 1242, h = 375;
   const std::string size = cl.value("--size", "1242x375");
   if (std::sscanf(size.c_str(), "%dx%d", &w, &h) != 2 || w < 64 || h < 32 || w > 4096 || h > 4096) {
@@ -103,13 +98,5 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const lsf::UsageError& e) {
-    std::cerr << "moving_rig_report: " << e.what() << "\n\n" << kUsage;
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "moving_rig_report: " << e.what() << "\n";
-    return 1;
-  }
+  return lsf::toolMain("moving_rig_report", kUsage, argc, argv, [&] { return run(argc, argv); });
 }

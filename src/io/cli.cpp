@@ -1,8 +1,9 @@
-// Command-line parsing for the tools.
+// Command-line parsing and the main of the tools.
 #include "lidar_stereo_fusion/io/cli.h"
 
 #include <climits>
 #include <cmath>
+#include <iostream>
 #include <sstream>
 
 namespace lidar_stereo_fusion {
@@ -84,6 +85,31 @@ std::string CommandLine::choice(const std::string& name, const std::string& fall
     valid += (valid.empty() ? "" : ", ") + c;
   }
   throw UsageError(name + " must be one of " + valid + ", got '" + v + "'");
+}
+
+bool wantsHelp(int argc, const char* const* argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") return true;
+  }
+  return false;
+}
+
+int toolMain(const std::string& name, const std::string& usage, int argc, const char* const* argv,
+             const std::function<int()>& run) {
+  if (wantsHelp(argc, argv)) {
+    std::cout << usage;
+    return 0;
+  }
+  try {
+    return run();
+  } catch (const UsageError& e) {
+    std::cerr << name << ": " << e.what() << "\n\n" << usage;
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << name << ": error: " << e.what() << "\n";
+    return 1;
+  }
 }
 
 }  // namespace lidar_stereo_fusion

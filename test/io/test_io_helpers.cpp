@@ -191,5 +191,30 @@ TEST(CommandLine, NumbersInARange) {
   }
 }
 
+TEST(CommandLine, ToolMainHelpUsageErrorsAndTheExitStatus) {
+  const char* help[] = {"tool", "--out", "x", "-h"};
+  const char* plain[] = {"tool"};
+  bool ran = false;
+  testing::internal::CaptureStdout();
+  EXPECT_EQ(toolMain("tool", "usage: tool\n", 4, help, [&] { return ran = true, 5; }), 0);
+  EXPECT_EQ(testing::internal::GetCapturedStdout(), "usage: tool\n");
+  EXPECT_FALSE(ran) << "--help runs nothing";
+  EXPECT_TRUE(wantsHelp(4, help));
+  EXPECT_FALSE(wantsHelp(1, plain));
+
+  EXPECT_EQ(toolMain("tool", "usage: tool\n", 1, plain, [] { return 3; }), 3);
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(toolMain("tool", "usage: tool\n", 1, plain,
+                     []() -> int { throw UsageError("--frames needs a value"); }),
+            2);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(),
+            "tool: --frames needs a value\n\nusage: tool\n");
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(toolMain("tool", "usage: tool\n", 1, plain,
+                     []() -> int { throw std::runtime_error("no such drive"); }),
+            1);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "tool: error: no such drive\n");
+}
+
 }  // namespace
 }  // namespace lidar_stereo_fusion

@@ -114,11 +114,7 @@ Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(
       argc, argv,
       {"--kitti-raw", "--out", "--calib-dir", "--frames", "--compression", "--period", "--cycles"},
-      {"-h", "--help"});
-  if (cl.has("-h") || cl.has("--help")) {
-    std::cout << usage();
-    std::exit(0);
-  }
+      {});
   Options options;
   options.drive_dir = cl.value("--kitti-raw");
   options.out = cl.value("--out");
@@ -256,16 +252,8 @@ void removePartial(const Options& options) {
   fs::remove(partialPath(options), ignored);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  Options options;
-  try {
-    options = parseOptions(argc, argv);
-  } catch (const lsf::UsageError& e) {
-    std::cerr << "kitti_to_bag: " << e.what() << "\n" << usage();
-    return 2;
-  }
+/// Writes the bag; on any failure removes the partial file first.
+int run(const Options& options) {
   try {
     if (!fs::is_directory(options.drive_dir)) {
       throw std::runtime_error("KITTI: --kitti-raw " + options.drive_dir + " is not a folder");
@@ -277,13 +265,18 @@ int main(int argc, char** argv) {
     writeBag(options, calib, frames, readEgoMotion(options, frames));
     std::cout << "kitti_to_bag: wrote " << frames.size() << " frame(s) to " << options.out << "\n";
   } catch (const rosbag::BagException& e) {
-    std::cerr << "kitti_to_bag: cannot write bag " << options.out << ": " << e.what() << "\n";
     removePartial(options);
-    return 1;
-  } catch (const std::exception& e) {
-    std::cerr << "kitti_to_bag: " << e.what() << "\n";
+    throw std::runtime_error("cannot write bag " + options.out + ": " + e.what());
+  } catch (...) {
     removePartial(options);
-    return 1;
+    throw;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return lsf::toolMain("kitti_to_bag", usage(), argc, argv,
+                       [&] { return run(parseOptions(argc, argv)); });
 }

@@ -1,7 +1,8 @@
-// A small command-line parser shared by the tools (kitti_runner, fusion_benchmark, kitti_to_bag,
-// ...). ROS-free.
+// The tools' command line (kitti_runner, fusion_benchmark, accuracy_report, kitti_to_bag, ...): a
+// small parser, and the one shape of their main (toolMain). ROS-free.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -39,5 +40,16 @@ class CommandLine {
   std::map<std::string, std::string> values_;
   std::set<std::string> flags_;
 };
+
+/// True when an argument is "--help" or "-h".
+bool wantsHelp(int argc, const char* const* argv);
+
+/// The main of every tool: with --help or -h, prints `usage` on stdout and returns 0; otherwise
+/// returns what `run` returns (it reads the command line and does the work). A UsageError, thrown
+/// while reading the command line or later, prints "<name>: <message>", a blank line and `usage`
+/// on stderr and returns 2; any other exception prints "<name>: error: <message>" on stderr and
+/// returns 1.
+int toolMain(const std::string& name, const std::string& usage, int argc, const char* const* argv,
+             const std::function<int()>& run);
 
 }  // namespace lidar_stereo_fusion
