@@ -28,6 +28,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "bag_runner_check.h"
+#include "child_process.h"
 #include "data/data_guard.h"
 #include "depth_agreement.h"
 #include "kitti_bag_expected.h"
@@ -48,6 +49,14 @@ constexpr double kFrameTimeout = 240.0;
 
 std::string makeSubsetDrive(const std::vector<std::string>& frames) {
   return lidar_stereo_fusion::test::makeSubsetDrive(scratchDir(), frames);
+}
+
+/// Messages in a map of message lists.
+template <class Map>
+size_t messageCount(const Map& map) {
+  size_t n = 0;
+  for (const auto& kv : map) n += kv.second.size();
+  return n;
 }
 
 /// The messages received on the fusion outputs, keyed by header stamp.
@@ -74,6 +83,17 @@ class OutputCollector {
     std::unique_lock<std::mutex> lock(mutex_);
     cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return complete(stamp); });
     return missing(stamp);
+  }
+
+  /// Waits at most `timeout_s` for a message beyond the `expected` of some output (a set
+  /// published twice); true when one came.
+  bool extraArrives(size_t expected, double timeout_s) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] {
+      return messageCount(disparity_) > expected || messageCount(depth_) > expected ||
+             messageCount(depth_info_) > expected || messageCount(points_) > expected ||
+             messageCount(lidar_disparity_) > expected || messageCount(stats_) > expected;
+    });
   }
 
   std::mutex mutex_;
@@ -118,13 +138,6 @@ class OutputCollector {
   std::vector<ros::Subscriber> subs_;
 };
 
-template <class Map>
-size_t messageCount(const Map& map) {
-  size_t n = 0;
-  for (const auto& kv : map) n += kv.second.size();
-  return n;
-}
-
 }  // namespace
 
 TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner) {
@@ -157,15 +170,14 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
 
   // The nodelet subscribes lazily: our output subscriptions make it subscribe to the inputs.
   // Wait for both sides, so that neither an input nor an output message can be lost.
-  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(60.0);
   auto connected = [&] {
     for (const auto& kv : inputs) {
       if (kv.second.getNumSubscribers() == 0) return false;
     }
     return outputs.connected();
   };
-  while (!connected() && ros::WallTime::now() < give_up) ros::WallDuration(0.1).sleep();
-  ASSERT_TRUE(connected()) << "the fusion nodelet did not connect to the bag's topics and ours";
+  ASSERT_TRUE(lidar_stereo_fusion::test::waitFor(60.0, connected))
+      << "the fusion nodelet did not connect to the bag's topics and ours";
 
   // Frame by frame: sweep, then the image set, then wait for every output of that frame.
   std::vector<ros::Time> stamps;
@@ -188,7 +200,9 @@ TEST(KittiBagReplay, FusionNodeletOutputsOneSetPerFrameMatchingTheOfflineRunner)
     std::printf("frame %s: outputs after %.1f s\n", kReplayFrames[i].c_str(),
                 (ros::WallTime::now() - start).toSec());
   }
-  ros::WallDuration(1.0).sleep();  // anything extra would arrive now
+  // No output follows the last frame's (a topic delivers in order: an extra message of an earlier
+  // frame would have come before it).
+  EXPECT_FALSE(outputs.extraArrives(stamps.size(), 1.0)) << "an output published twice";
 
   // The offline runner on the same three frames.
   const std::string runner_out = scratchDir() + "/runner";
