@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -185,6 +186,45 @@ bool deskewSweep(const Context& c, const std::string& name, lsf::LidarCloud& clo
   }
 }
 
+/// --photometric-check before the deskew and, when the sweep was deskewed, after it; and --deskew.
+void deskewAndCheck(const Context& c, const std::string& name, lsf::kitti::FrameData& data,
+                    Results& results) {
+  std::optional<lsf::PhotometricShifts> before;
+  if (c.options.photometric_check) before = shiftsOf(c, data, data.cloud);
+  const bool deskewed = c.deskew && deskewSweep(c, name, data.cloud, results);
+  if (!before) return;
+  lsf::ShiftRow row{name, lsf::summarizeShifts(before->shifts), std::nullopt};
+  results.shifts_before.insert(results.shifts_before.end(), before->shifts.begin(),
+                               before->shifts.end());
+  if (deskewed) {
+    const lsf::PhotometricShifts after = shiftsOf(c, data, data.cloud);
+    row.after = lsf::summarizeShifts(after.shifts);
+    results.shifts_after.insert(results.shifts_after.end(), after.shifts.begin(),
+                                after.shifts.end());
+  }
+  results.shift_rows.push_back(row);
+}
+
+/// The frame's depth PNG (and PCD, pictures), its score against the reference, its stats.
+void writeFrame(const Context& c, const std::string& name, const cv::Mat& left,
+                const lsf::FusionResult& result, const std::optional<cv::Mat1f>& reference,
+                Results& results) {
+  const Options& o = c.options;
+  lsf::kitti::writeDepthPng((fs::path(o.out) / (name + ".png")).string(), result.depth);
+  if (o.save_pcd) {
+    lsf::pcd::writeColoredPcd((fs::path(o.out) / (name + ".pcd")).string(),
+                              lsf::makeColoredCloud(result.depth, left, c.calib.camera));
+  }
+  if (reference) {
+    results.scores.push_back(lsf::evaluateDepth(result.depth, *reference, c.calib.camera));
+    results.rows.push_back({name, results.scores.back()});
+  }
+  if (o.save_vis) {
+    saveVisualisation(fs::path(o.out) / "vis", name, left, result, reference, c.calib.camera);
+  }
+  results.stats.push_back(result.stats);
+}
+
 /// Runs one frame and writes its outputs; throws std::runtime_error naming the problem.
 void runFrame(const Context& c, const lsf::kitti::Frame& frame, lsf::FusionPipeline& pipeline,
               Results& results) {
@@ -196,21 +236,7 @@ void runFrame(const Context& c, const lsf::kitti::Frame& frame, lsf::FusionPipel
               << " are implausible (" << data.rings.fallbacks << "); using "
               << lsf::ringSourceName(data.rings.source) << " (" << data.rings.rings << " rings)\n";
   }
-  std::optional<lsf::PhotometricShifts> before;
-  if (o.photometric_check) before = shiftsOf(c, data, data.cloud);
-  const bool deskewed = c.deskew && deskewSweep(c, frame.name, data.cloud, results);
-  if (before) {
-    lsf::ShiftRow row{frame.name, lsf::summarizeShifts(before->shifts), std::nullopt};
-    results.shifts_before.insert(results.shifts_before.end(), before->shifts.begin(),
-                                 before->shifts.end());
-    if (deskewed) {
-      const lsf::PhotometricShifts after = shiftsOf(c, data, data.cloud);
-      row.after = lsf::summarizeShifts(after.shifts);
-      results.shifts_after.insert(results.shifts_after.end(), after.shifts.begin(),
-                                  after.shifts.end());
-    }
-    results.shift_rows.push_back(row);
-  }
+  deskewAndCheck(c, frame.name, data, results);
   lsf::FusionInput input{data.left, data.right, {}, calib.T_cam_velo, calib.camera};
   std::optional<cv::Mat1f> reference;
   if (o.holdout == "even") {
@@ -232,20 +258,7 @@ void runFrame(const Context& c, const lsf::kitti::Frame& frame, lsf::FusionPipel
     throw std::runtime_error("no LiDAR point in front of the camera in " + frame.velodyne +
                              " (check the sweep and calib_velo_to_cam.txt)");
   }
-  lsf::kitti::writeDepthPng((fs::path(o.out) / (frame.name + ".png")).string(), result.depth);
-  if (o.save_pcd) {
-    lsf::pcd::writeColoredPcd((fs::path(o.out) / (frame.name + ".pcd")).string(),
-                              lsf::makeColoredCloud(result.depth, data.left, calib.camera));
-  }
-  if (reference) {
-    results.scores.push_back(lsf::evaluateDepth(result.depth, *reference, calib.camera));
-    results.rows.push_back({frame.name, results.scores.back()});
-  }
-  if (o.save_vis) {
-    saveVisualisation(fs::path(o.out) / "vis", frame.name, data.left, result, reference,
-                      calib.camera);
-  }
-  results.stats.push_back(result.stats);
+  writeFrame(c, frame.name, data.left, result, reference, results);
 }
 
 /// The tables of --photometric-check and the time --deskew took.
@@ -270,15 +283,18 @@ void printChecks(const Options& o, const Results& results) {
   }
 }
 
-int run(const Options& o) {
-  const lsf::FusionParams params = loadParams(o);
+/// The drive's complete frames (the first --frames), the calibration and --deskew's inputs, and
+/// the output folder; warns about the incomplete frames.
+std::vector<lsf::kitti::Frame> openDrive(const Options& o, std::unique_ptr<Context>& c,
+                                         const lsf::FusionParams& params,
+                                         std::vector<std::string>& incomplete) {
   // The drive first: a wrong --kitti-raw must be named as such, not as a missing calibration.
-  std::vector<std::string> incomplete;
   std::vector<lsf::kitti::Frame> frames = lsf::kitti::listFrames(o.drive, &incomplete);
-  Context c{o, lsf::kitti::readCalibration(lsf::kitti::calibrationDirOf(o.drive)), params, {}};
+  c.reset(new Context{
+      o, lsf::kitti::readCalibration(lsf::kitti::calibrationDirOf(o.drive)), params, {}});
   if (o.deskew) {  // missing drive-wide inputs fail the run; a frame's missing packet does not
-    c.deskew = Deskew{lsf::kitti::readDriveStamps(o.drive),
-                      lsf::kitti::readImuToVelo(lsf::kitti::calibrationDirOf(o.drive))};
+    c->deskew = Deskew{lsf::kitti::readDriveStamps(o.drive),
+                       lsf::kitti::readImuToVelo(lsf::kitti::calibrationDirOf(o.drive))};
   }
   for (const std::string& line : incomplete) {
     std::cerr << "kitti_runner: warning: skipped " << line << "\n";
@@ -291,32 +307,14 @@ int run(const Options& o) {
   createDirectory(o.out);
   requireWritable(o.out);
   if (o.save_vis) createDirectory(fs::path(o.out) / "vis");
+  return frames;
+}
 
-  std::cerr << "kitti_runner: " << frames.size() << " frames, method "
-            << lsf::methodName(params.method)
-            << (o.holdout == "even" ? ", hold-out: even rings in, odd rings scored" : "")
-            << (o.deskew ? ", sweeps deskewed" : "") << "\n";
-  lsf::FusionPipeline pipeline(params);
-  Results results;
+/// The scores, timings and checks, and what was not processed as asked.
+void printResults(const Options& o, const lsf::FusionParams& params, Results& results,
+                  size_t frames, const std::vector<std::string>& failed,
+                  const std::vector<std::string>& incomplete) {
   const std::vector<lsf::DepthMetrics>& scores = results.scores;
-  std::vector<std::string> failed;
-  lsf::ProgressBar progress(std::cerr, static_cast<int>(frames.size()), ::isatty(2) != 0);
-  for (size_t i = 0; i < frames.size(); ++i) {
-    progress.update(static_cast<int>(i), frames[i].name);
-    try {
-      runFrame(c, frames[i], pipeline, results);
-    } catch (const std::exception& e) {  // name it and go on with the next frame
-      failed.push_back(frames[i].name);
-      std::cerr << "\nkitti_runner: error: frame " << frames[i].name << " failed: " << e.what()
-                << "\n";
-    }
-  }
-  progress.update(static_cast<int>(frames.size()), "done");
-  progress.finish();
-
-  if (!o.reference.empty() && scores.empty() && failed.size() < frames.size()) {
-    throw std::runtime_error("no frame has a reference PNG in " + o.reference);
-  }
   if (!scores.empty()) {
     results.rows.push_back(
         {"mean (" + std::to_string(scores.size()) + " frames)", lsf::averageMetrics(scores)});
@@ -333,16 +331,47 @@ int run(const Options& o) {
   if (!results.undeskewed.empty()) {
     std::string names;
     for (const auto& name : results.undeskewed) names += " " + name;
-    std::cerr << "kitti_runner: " << results.undeskewed.size() << " of " << frames.size()
+    std::cerr << "kitti_runner: " << results.undeskewed.size() << " of " << frames
               << " frames not deskewed (processed as measured):" << names << "\n";
   }
   if (!failed.empty() || !incomplete.empty()) {
     std::string names;
     for (const auto& name : failed) names += " " + name;
-    std::cerr << "kitti_runner: " << failed.size() << " of " << frames.size() << " frames failed"
+    std::cerr << "kitti_runner: " << failed.size() << " of " << frames << " frames failed"
               << (failed.empty() ? "" : ":" + names) << "; " << incomplete.size()
               << " incomplete frames skipped\n";
   }
+}
+
+int run(const Options& o) {
+  const lsf::FusionParams params = loadParams(o);
+  std::vector<std::string> incomplete;
+  std::unique_ptr<Context> c;
+  const std::vector<lsf::kitti::Frame> frames = openDrive(o, c, params, incomplete);
+  std::cerr << "kitti_runner: " << frames.size() << " frames, method "
+            << lsf::methodName(params.method)
+            << (o.holdout == "even" ? ", hold-out: even rings in, odd rings scored" : "")
+            << (o.deskew ? ", sweeps deskewed" : "") << "\n";
+  lsf::FusionPipeline pipeline(params);
+  Results results;
+  std::vector<std::string> failed;
+  lsf::ProgressBar progress(std::cerr, static_cast<int>(frames.size()), ::isatty(2) != 0);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    progress.update(static_cast<int>(i), frames[i].name);
+    try {
+      runFrame(*c, frames[i], pipeline, results);
+    } catch (const std::exception& e) {  // name it and go on with the next frame
+      failed.push_back(frames[i].name);
+      std::cerr << "\nkitti_runner: error: frame " << frames[i].name << " failed: " << e.what()
+                << "\n";
+    }
+  }
+  progress.update(static_cast<int>(frames.size()), "done");
+  progress.finish();
+  if (!o.reference.empty() && results.scores.empty() && failed.size() < frames.size()) {
+    throw std::runtime_error("no frame has a reference PNG in " + o.reference);
+  }
+  printResults(o, params, results, frames.size(), failed, incomplete);
   return failed.empty() && results.undeskewed.empty() ? 0 : 1;
 }
 
