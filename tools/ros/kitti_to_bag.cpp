@@ -167,21 +167,12 @@ boost::shared_ptr<ros::M_string> latchedConnectionHeader() {
 
 std::string partialPath(const Options& options) { return options.out + ".partial"; }
 
-void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
-              const std::vector<lsf::KittiBagFrame>& frames, const lsf::KittiEgoMotion& ego) {
-  const sensor_msgs::CameraInfo left_info_base =
-      lsf::rectifiedCameraInfo(calib.camera, kLeftFrame, false);
-  const sensor_msgs::CameraInfo right_info_base =
-      lsf::rectifiedCameraInfo(calib.camera, kRightFrame, true);
-
-  // Written under a temporary name and renamed when complete, so that a failed conversion never
-  // leaves a truncated bag under the requested name.
-  rosbag::Bag bag;
-  bag.open(partialPath(options), rosbag::bagmode::Write);
-  bag.setCompression(options.compression);
-
-  // Static transforms first, at the earliest stamp of the bag (their stamps do not matter to
-  // tf2's static buffer; a first message time keeps `rosbag play` from waiting).
+/// The static transforms (velodyne -> left, left -> right, imu -> velodyne) at the bag's
+/// earliest stamp (their stamps do not matter to tf2's static buffer; a first message time keeps
+/// `rosbag play` from waiting), then the ego-motion on /tf.
+void writeTransforms(rosbag::Bag& bag, const lsf::kitti::Calibration& calib,
+                     const std::vector<lsf::KittiBagFrame>& frames,
+                     const lsf::KittiEgoMotion& ego) {
   ros::Time first = frames.front().image_stamp;
   for (const auto& f : frames) first = std::min({first, f.image_stamp, f.cloud_stamp});
   if (!ego.samples.empty()) first = std::min(first, ros::Time(ego.samples.front().stamp));
@@ -200,37 +191,50 @@ void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
     tf.transforms.push_back(transform);
     bag.write(kTfTopic, transform.header.stamp, tf);
   }
+}
 
+/// One frame's sweep, camera infos and images (`seq` numbers its headers).
+void writeFrame(rosbag::Bag& bag, const lsf::KittiBagFrame& frame, uint32_t seq,
+                const lsf::kitti::Calibration& calib) {
+  std_msgs::Header left_header, right_header, cloud_header;
+  left_header.seq = right_header.seq = cloud_header.seq = seq;
+  left_header.stamp = right_header.stamp = frame.image_stamp;
+  left_header.frame_id = kLeftFrame;
+  right_header.frame_id = kRightFrame;
+  cloud_header.stamp = frame.cloud_stamp;
+  cloud_header.frame_id = kVelodyneFrame;
+
+  sensor_msgs::CameraInfo left_info = lsf::rectifiedCameraInfo(calib.camera, kLeftFrame, false);
+  sensor_msgs::CameraInfo right_info = lsf::rectifiedCameraInfo(calib.camera, kRightFrame, true);
+  left_info.header = left_header;
+  right_info.header = right_header;
+  const lsf::kitti::FrameData data = loadFrame(frame, calib.camera);
+  // The fields of velodyne_pointcloud: x, y, z, intensity, ring, time.
+  sensor_msgs::PointCloud2 cloud = lsf::conversions::cloudToMsg(data.cloud, cloud_header);
+  cloud.is_dense = std::all_of(data.cloud.begin(), data.cloud.end(), [](const lsf::LidarPoint& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  });
+  bag.write(kCloudTopic, frame.cloud_stamp, cloud);
+  bag.write(kLeftInfoTopic, frame.image_stamp, left_info);
+  bag.write(kLeftImageTopic, frame.image_stamp,
+            cv_bridge::CvImage(left_header, "bgr8", data.left).toImageMsg());
+  bag.write(kRightInfoTopic, frame.image_stamp, right_info);
+  bag.write(kRightImageTopic, frame.image_stamp,
+            cv_bridge::CvImage(right_header, "bgr8", data.right).toImageMsg());
+  std::cout << "kitti_to_bag: frame " << frame.files.name << ": images at " << frame.image_stamp
+            << " s, " << cloud.width << " points at " << frame.cloud_stamp << " s\n";
+}
+
+void writeBag(const Options& options, const lsf::kitti::Calibration& calib,
+              const std::vector<lsf::KittiBagFrame>& frames, const lsf::KittiEgoMotion& ego) {
+  // Written under a temporary name and renamed when complete, so that a failed conversion never
+  // leaves a truncated bag under the requested name.
+  rosbag::Bag bag;
+  bag.open(partialPath(options), rosbag::bagmode::Write);
+  bag.setCompression(options.compression);
+  writeTransforms(bag, calib, frames, ego);
   uint32_t seq = 0;
-  for (const lsf::KittiBagFrame& frame : frames) {
-    std_msgs::Header left_header, right_header, cloud_header;
-    left_header.seq = right_header.seq = cloud_header.seq = seq++;
-    left_header.stamp = right_header.stamp = frame.image_stamp;
-    left_header.frame_id = kLeftFrame;
-    right_header.frame_id = kRightFrame;
-    cloud_header.stamp = frame.cloud_stamp;
-    cloud_header.frame_id = kVelodyneFrame;
-
-    sensor_msgs::CameraInfo left_info = left_info_base, right_info = right_info_base;
-    left_info.header = left_header;
-    right_info.header = right_header;
-    const lsf::kitti::FrameData data = loadFrame(frame, calib.camera);
-    // The fields of velodyne_pointcloud: x, y, z, intensity, ring, time.
-    sensor_msgs::PointCloud2 cloud = lsf::conversions::cloudToMsg(data.cloud, cloud_header);
-    cloud.is_dense =
-        std::all_of(data.cloud.begin(), data.cloud.end(), [](const lsf::LidarPoint& p) {
-          return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-        });
-    bag.write(kCloudTopic, frame.cloud_stamp, cloud);
-    bag.write(kLeftInfoTopic, frame.image_stamp, left_info);
-    bag.write(kLeftImageTopic, frame.image_stamp,
-              cv_bridge::CvImage(left_header, "bgr8", data.left).toImageMsg());
-    bag.write(kRightInfoTopic, frame.image_stamp, right_info);
-    bag.write(kRightImageTopic, frame.image_stamp,
-              cv_bridge::CvImage(right_header, "bgr8", data.right).toImageMsg());
-    std::cout << "kitti_to_bag: frame " << frame.files.name << ": images at " << frame.image_stamp
-              << " s, " << cloud.width << " points at " << frame.cloud_stamp << " s\n";
-  }
+  for (const lsf::KittiBagFrame& frame : frames) writeFrame(bag, frame, seq++, calib);
   bag.close();
   fs::rename(partialPath(options), options.out);
 }

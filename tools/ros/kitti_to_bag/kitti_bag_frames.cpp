@@ -52,11 +52,10 @@ std::string joined(const std::vector<std::string>& names) {
 
 }  // namespace
 
-std::vector<KittiBagFrame> selectKittiBagFrames(const std::string& drive_dir, int max_frames) {
-  const fs::path drive(drive_dir);
-  const std::vector<kitti::Frame> complete = kitti::listFrames(drive_dir);
+namespace {
 
-  // Report files that cannot form a frame (e.g. LiDAR-only frames between the stereo frames).
+/// Names the files that cannot form a frame (e.g. LiDAR-only frames between the stereo frames).
+void reportIncomplete(const fs::path& drive, const std::vector<kitti::Frame>& complete) {
   std::set<std::string> all = stemsIn(drive / "image_02" / "data", ".png");
   const std::set<std::string> right = stemsIn(drive / "image_03" / "data", ".png");
   const std::set<std::string> sweeps = stemsIn(drive / "velodyne_points" / "data", ".bin");
@@ -73,34 +72,51 @@ std::vector<KittiBagFrame> selectKittiBagFrames(const std::string& drive_dir, in
               << " frame(s) without all of image_02, image_03 and a Velodyne sweep: "
               << joined(incomplete) << "\n";
   }
+}
+
+/// The drive's image and sweep stamps by frame, and the sweep starts when the drive has them.
+struct DriveStampFiles {
+  std::vector<std::optional<double>> images, sweeps, starts;
+  bool have_end = false;  ///< sweeps stamped at their end (timestamps_end.txt)
+};
+
+/// Sweep stamps: the sweep end (timestamps_end.txt), as velodyne_driver stamps a scan at its last
+/// packet; without that file, the forward-facing instant (timestamps.txt, mid-sweep).
+DriveStampFiles readStampFiles(const fs::path& drive) {
+  const fs::path velo_dir = drive / "velodyne_points";
+  DriveStampFiles d;
+  d.have_end = fs::is_regular_file(velo_dir / "timestamps_end.txt");
+  d.images = readTimestampsByFrame(drive / "image_02" / "timestamps.txt");
+  d.sweeps =
+      readTimestampsByFrame(velo_dir / (d.have_end ? "timestamps_end.txt" : "timestamps.txt"));
+  if (fs::is_regular_file(velo_dir / "timestamps_start.txt")) {
+    d.starts = readTimestampsByFrame(velo_dir / "timestamps_start.txt");
+  }
+  if (!d.have_end) {
+    std::cerr << "kitti_to_bag: no velodyne_points/timestamps_end.txt: stamping sweeps at the "
+                 "forward-facing instant (timestamps.txt)\n";
+  }
+  return d;
+}
+
+}  // namespace
+
+std::vector<KittiBagFrame> selectKittiBagFrames(const std::string& drive_dir, int max_frames) {
+  const fs::path drive(drive_dir);
+  const std::vector<kitti::Frame> complete = kitti::listFrames(drive_dir);
+  reportIncomplete(drive, complete);
   if (complete.empty()) {
     throw std::runtime_error("KITTI: " + drive_dir +
                              " has no frame with image_02, image_03 and velodyne_points data");
   }
-
-  // Sweep stamps: the sweep end (timestamps_end.txt), as velodyne_driver stamps a scan at its
-  // last packet; without that file, the forward-facing instant (timestamps.txt, mid-sweep).
-  const fs::path velo_dir = drive / "velodyne_points";
-  const bool have_end = fs::is_regular_file(velo_dir / "timestamps_end.txt");
-  const auto image_stamps = readTimestampsByFrame(drive / "image_02" / "timestamps.txt");
-  const auto sweep_stamps =
-      readTimestampsByFrame(velo_dir / (have_end ? "timestamps_end.txt" : "timestamps.txt"));
-  std::vector<std::optional<double>> starts;
-  if (fs::is_regular_file(velo_dir / "timestamps_start.txt")) {
-    starts = readTimestampsByFrame(velo_dir / "timestamps_start.txt");
-  }
-  if (!have_end) {
-    std::cerr << "kitti_to_bag: no velodyne_points/timestamps_end.txt: stamping sweeps at the "
-                 "forward-facing instant (timestamps.txt)\n";
-  }
-
+  const DriveStampFiles stamps = readStampFiles(drive);
   std::vector<KittiBagFrame> frames;
   std::vector<std::string> unstamped;
   for (const auto& files : complete) {
     if (max_frames > 0 && static_cast<int>(frames.size()) >= max_frames) break;
     const size_t index = kitti::frameIndex(files.name);
-    const auto image_stamp = stampOf(image_stamps, index);
-    const auto sweep_stamp = stampOf(sweep_stamps, index);
+    const auto image_stamp = stampOf(stamps.images, index);
+    const auto sweep_stamp = stampOf(stamps.sweeps, index);
     if (!image_stamp || !sweep_stamp) {
       unstamped.push_back(files.name);
       continue;
@@ -110,8 +126,9 @@ std::vector<KittiBagFrame> selectKittiBagFrames(const std::string& drive_dir, in
     frame.image_stamp = ros::Time(*image_stamp);
     frame.cloud_stamp = ros::Time(*sweep_stamp);
     frame.sweep = kitti::sweepClock(
-        *sweep_stamp, stampOf(starts, index).value_or(std::numeric_limits<double>::quiet_NaN()),
-        have_end);
+        *sweep_stamp,
+        stampOf(stamps.starts, index).value_or(std::numeric_limits<double>::quiet_NaN()),
+        stamps.have_end);
     frames.push_back(frame);
   }
   if (!unstamped.empty()) {
