@@ -88,11 +88,13 @@ int main(int argc, char** argv) {
     }
   }
 
+  // The measurement ends when its window does (or ROS shuts down first).
+  const ros::WallTimer end = nh.createWallTimer(
+      ros::WallDuration(warmup + duration) - (ros::WallTime::now() - start),
+      [](const ros::WallTimerEvent&) { ros::shutdown(); }, /*oneshot=*/true);
   ros::AsyncSpinner spinner(2);
   spinner.start();
-  while (ros::ok() && (ros::WallTime::now() - start).toSec() < warmup + duration) {
-    ros::WallDuration(0.2).sleep();
-  }
+  ros::waitForShutdown();
   std::lock_guard<std::mutex> lock(mutex);
   if (samples.size() < 2) {
     std::printf("measure_fusion: %zu frames in %.0f s: no rate\n", samples.size(), duration);

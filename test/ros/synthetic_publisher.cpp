@@ -44,9 +44,10 @@ int main(int argc, char** argv) {
   tf.sendTransform(transform);
   ROS_INFO("synthetic_publisher: publishing at %.1f Hz", rate);
 
-  ros::Rate loop(rate);
-  for (std::size_t i = 0; ros::ok(); ++i) {
-    const auto& f = frames[i % frames.size()];
+  // A timer at the rate (ROS time, as the rig's driver would stamp), served by ros::spin().
+  std::size_t i = 0;
+  const ros::Timer timer = nh.createTimer(ros::Duration(1.0 / rate), [&](const ros::TimerEvent&) {
+    const auto& f = frames[i++ % frames.size()];
     const ros::Time stamp = ros::Time::now();
     left_info.publish(lsf::test::cameraInfoMsg(f.camera, false, lsf::test::kCameraFrame, stamp));
     right_info.publish(
@@ -55,8 +56,7 @@ int main(int argc, char** argv) {
     right_image.publish(
         lsf::test::imageMsg(f.right, encoding, lsf::test::kRightCameraFrame, stamp));
     if (publish_cloud) cloud.publish(lsf::test::cloudMsg(f.cloud, lsf::test::kLidarFrame, stamp));
-    ros::spinOnce();
-    loop.sleep();
-  }
+  });
+  ros::spin();
   return 0;
 }
