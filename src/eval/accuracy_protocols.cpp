@@ -12,6 +12,7 @@
 
 #include "lidar_stereo_fusion/core/depth.h"
 #include "lidar_stereo_fusion/eval/holdout.h"
+#include "lidar_stereo_fusion/eval/pseudo_lidar.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/middlebury.h"
 

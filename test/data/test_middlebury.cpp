@@ -11,6 +11,7 @@
 
 #include "data/data_guard.h"
 #include "lidar_stereo_fusion/eval/accuracy_protocols.h"
+#include "lidar_stereo_fusion/eval/pseudo_lidar.h"
 #include "lidar_stereo_fusion/io/middlebury.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
 

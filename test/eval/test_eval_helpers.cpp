@@ -1,8 +1,9 @@
-// The small evaluation helpers on synthetic input with exact answers: ring hold-out, metric
-// tables.
+// The small evaluation helpers on synthetic input with exact answers: ring hold-out, row-sampled
+// pseudo-LiDAR, metric tables.
 #include <gtest/gtest.h>
 
 #include "lidar_stereo_fusion/eval/holdout.h"
+#include "lidar_stereo_fusion/eval/pseudo_lidar.h"
 #include "lidar_stereo_fusion/eval/report.h"
 
 namespace lidar_stereo_fusion {
@@ -91,6 +92,59 @@ TEST(RingHoldout, MakeRingHoldoutFeedsEvenRingsAndFailsWithoutReference) {
   EXPECT_EQ(cv::countNonZero(holdout.reference_depth), 1);
   EXPECT_THROW(makeRingHoldout({point(0, 0, 10, 0)}, identity, camera(), ProjectionParams()),
                std::invalid_argument);
+}
+
+TEST(PseudoLidar, EvenlySpacedRowsWithRingIdsAndOnlyKnownDisparities) {
+  cv::Mat1f gt(8, 5, 3.f);
+  gt(1, 2) = 0.f;                                               // unknown: not sampled
+  const SparseDisparity sparse = sampleRowsAsScanLines(gt, 4);  // rows 1, 3, 5, 7
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 5; ++x) {
+      const bool sampled = y % 2 == 1 && !(y == 1 && x == 2);
+      EXPECT_EQ(sparse.disparity(y, x), sampled ? 3.f : 0.f) << x << "," << y;
+      EXPECT_EQ(sparse.ring(y, x), sampled ? y / 2 : -1) << x << "," << y;
+    }
+  }
+  EXPECT_EQ(sparse.points_in_image, 19);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 1), std::invalid_argument);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 9), std::invalid_argument);
+}
+
+TEST(PseudoLidar, FirstRowSpreadsTheRowsOverTheLowerPartOnly) {
+  // 12 rows, first row 4: rows 4 + floor((k + 0.5) * 8 / 4) = 5, 7, 9, 11.
+  const cv::Mat1f gt(12, 3, 2.f);
+  const SparseDisparity sparse = sampleRowsAsScanLines(gt, 4, 4);
+  for (int y = 0; y < 12; ++y) {
+    const bool sampled = y == 5 || y == 7 || y == 9 || y == 11;
+    EXPECT_EQ(cv::countNonZero(sparse.disparity.row(y)), sampled ? 3 : 0) << y;
+    if (sampled) {
+      EXPECT_EQ(sparse.ring(y, 0), (y - 5) / 2) << y;
+    }
+  }
+  EXPECT_EQ(scanLineRow(0, 4, 12, 4), 5);
+  EXPECT_EQ(scanLineRow(3, 4, 12, 4), 11);
+  EXPECT_EQ(scanLineRow(1, 3, 10, 0), 5);  // floor(1.5 * 10 / 3)
+  // Default first row 0 keeps the old layout.
+  EXPECT_EQ(cv::countNonZero(sampleRowsAsScanLines(gt, 4).disparity.row(1)), 3);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 4, -1), std::invalid_argument);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 2, 11), std::invalid_argument);
+  EXPECT_THROW(sampleRowsAsScanLines(gt, 9, 4), std::invalid_argument);  // 8 rows below row 4
+}
+
+TEST(PseudoLidar, RightViewShiftsByTheRoundedDisparityAndTheNearerSampleWins) {
+  SparseDisparity left;
+  left.disparity = cv::Mat1f(1, 10, 0.f);
+  left.ring = cv::Mat1s(1, 10, static_cast<int16_t>(-1));
+  left.disparity(0, 5) = 2.4f;  // -> 2.6 -> 3
+  left.ring(0, 5) = 7;
+  left.disparity(0, 7) = 4.f;  // -> 3: nearer, wins
+  left.ring(0, 7) = 8;
+  left.disparity(0, 1) = 3.f;  // -> -2: outside
+  const SparseDisparity right = shiftToRightView(left);
+  EXPECT_EQ(right.disparity(0, 3), 4.f);
+  EXPECT_EQ(right.ring(0, 3), 8);
+  EXPECT_EQ(cv::countNonZero(right.disparity), 1);
+  EXPECT_EQ(right.points_in_image, 2);
 }
 
 TEST(Report, TablesAndMedian) {

@@ -26,8 +26,7 @@ class ToolMain : public ::testing::TestWithParam<const char*> {
   void TearDown() override { fs::remove_all(scratch_); }
   /// Runs the tool in the scratch folder, so that anything it writes lands there.
   lsf::test::RunResult run(const std::string& args) const {
-    return lsf::test::runCommand("cd " + scratch_.string() + " && " + path_ + " " + args,
-                                 scratch_);
+    return lsf::test::runCommand("cd " + scratch_.string() + " && " + path_ + " " + args, scratch_);
   }
   /// Entries of the scratch folder besides the captured output.
   int written() const {
