@@ -17,7 +17,21 @@ WS=${LSF_WS:-$ROOT/ws}
 DATA=${LSF_DATA_DIR:-$(cd "$ROOT/.." && pwd)/shared/data}
 JOBS=${LSF_JOBS:-2}
 
+# Where the time goes: each phase's wall time, printed at the end (doc/tools.md has a table).
+PHASES=()
+phase_start=$SECONDS
+phase_done() {
+  PHASES+=("$(printf '%6d s  %s' $((SECONDS - phase_start)) "$1")")
+  phase_start=$SECONDS
+}
+print_phases() {
+  echo "== time per phase"
+  printf '%s\n' "${PHASES[@]}"
+  printf '%6d s  total\n' "$SECONDS"
+}
+
 bash "$ROOT/scripts/install_deps.sh"
+phase_done "install (scripts/install_deps.sh)"
 
 echo "== format (clang-format 14, .clang-format)"
 format_status=0
@@ -25,6 +39,7 @@ bash "$ROOT/scripts/check_format.sh" || format_status=$?
 echo "== docs (doc/method.md names existing files and functions)"
 docs_status=0
 bash "$ROOT/scripts/check_docs.sh" || docs_status=$?
+phase_done "format and docs checks"
 
 # Debian's ROS uses the system Python; a pyenv python3 first on PATH breaks catkin.
 export PATH=/usr/bin:/bin:$PATH
@@ -55,14 +70,21 @@ CMAKE_ARGS=(-DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/p
 
 echo "== build (catkin workspace $WS)"
 catkin_make "${CMAKE_ARGS[@]}" -j"$JOBS" all
+phase_done "build: catkin_make all"
 # `run_tests` builds only the test targets, so `all` comes first.
 rm -rf "$WS/build/test_results"
-echo "== tests"
+echo "== build the tests"
 set +eu  # catkin's setup scripts read unset variables
 # shellcheck disable=SC1091
 source "$WS/devel/setup.bash"
+catkin_make "${CMAKE_ARGS[@]}" -j"$JOBS" tests
+build_tests_status=$?
+phase_done "build: catkin_make tests (test binaries, rostest nodes)"
+echo "== tests"
 catkin_make "${CMAKE_ARGS[@]}" -j"$JOBS" run_tests
 run_status=$?
+if [ $build_tests_status -ne 0 ]; then run_status=$build_tests_status; fi
+phase_done "tests: catkin_make run_tests"
 set -e
 
 summary_status=0
@@ -73,7 +95,9 @@ fuzz_status=0
 if [ "${LSF_FUZZ_SECONDS:-20}" != "0" ]; then
   LSF_FUZZ_BUILD=${LSF_FUZZ_BUILD:-$WS/build_fuzz} bash "$ROOT/scripts/run_fuzz.sh" \
     "$WS/build/lidar_stereo_fusion/fuzz_seeds" "${LSF_FUZZ_SECONDS:-20}" || fuzz_status=$?
+  phase_done "fuzz: build (clang, ASan + UBSan) and ${LSF_FUZZ_SECONDS:-20} s per target"
 fi
+print_phases
 
 if [ $run_status -ne 0 ]; then
   echo "run_tests exited with $run_status" >&2
