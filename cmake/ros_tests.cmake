@@ -50,7 +50,8 @@ function(lsf_add_ros_test_node target)
   endif()
 endfunction()
 
-# One binary of four sources (tests in this order); the .test files pick tests by --gtest_filter.
+# One binary of four sources (any order: each test sets up what it needs); the .test files pick
+# tests by --gtest_filter.
 lsf_add_ros_test_node(test_fusion_node test/ros/test_fusion_node.cpp
   test/ros/test_fusion_node_input.cpp test/ros/test_fusion_node_params.cpp
   test/ros/test_fusion_node_issues.cpp)
