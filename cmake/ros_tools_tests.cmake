@@ -33,6 +33,13 @@ function(lsf_add_tools_rostest target launch_file)
   endif()
 endfunction()
 
+# Issue 33: bag_runner's files (outputs apart from inputs, temporary names, manifest); no master.
+catkin_add_gtest(test_bag_files test/ros/test_bag_files.cpp)
+if(TARGET test_bag_files)
+  lsf_tools_test_setup(test_bag_files)
+  target_link_libraries(test_bag_files ${PROJECT_NAME}_bag ${GTEST_MAIN_LIBRARIES})
+endif()
+
 # Direction and content of the TF / camera_info messages (tf2 buffer, no ROS master).
 catkin_add_gtest(test_calibration_msgs test/ros/test_calibration_msgs.cpp)
 if(TARGET test_calibration_msgs)
