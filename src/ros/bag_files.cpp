@@ -66,8 +66,8 @@ std::string errnoText() { return std::strerror(errno); }
 
 std::string tempPath(const std::string& path) {
   const fs::path p(path);
-  return (p.parent_path() / ("." + p.filename().string() + "~" + std::to_string(::getpid()) +
-                             "@" + hostName() + ".tmp"))
+  return (p.parent_path() / ("." + p.filename().string() + "~" + std::to_string(::getpid()) + "@" +
+                             hostName() + ".tmp"))
       .string();
 }
 
@@ -96,8 +96,7 @@ void checkOutputsAgainstInputs(const std::vector<LabelledPath>& outputs,
           fs::equivalent(out.path, in.path, ec)) {
         throw std::runtime_error("refusing to write " + out.label + " " + out.path +
                                  ": it is the " + in.label + " " + in.path +
-                                 " (the same file, or a link to it); choose another " +
-                                 out.label);
+                                 " (the same file, or a link to it); choose another " + out.label);
       }
     }
     for (std::size_t j = 0; j < i; ++j) {
@@ -141,8 +140,8 @@ bool isStampFile(const std::string& name, const std::string& ext) {
   }
   const std::string stem = name.substr(0, name.size() - ext.size());
   const auto dot = stem.find('.');
-  return dot != std::string::npos && digits(stem.substr(0, dot)) &&
-         stem.size() - dot - 1 == 9 && digits(stem.substr(dot + 1));
+  return dot != std::string::npos && digits(stem.substr(0, dot)) && stem.size() - dot - 1 == 9 &&
+         digits(stem.substr(dot + 1));
 }
 
 int removeEarlierOutputs(const std::string& dir) {

@@ -113,12 +113,11 @@ void applyRemap(const std::string& argument, BagTopics& topics,
   }
   // As ROS resolves a relative name for a node in the root namespace.
   const std::string topic = ros::names::resolve("/", to, false);
-  const std::map<std::string, std::string*> inputs = {
-      {kLeftImage, &topics.left_image},
-      {kLeftInfo, &topics.left_info},
-      {kRightImage, &topics.right_image},
-      {kRightInfo, &topics.right_info},
-      {kCloud, &topics.cloud}};
+  const std::map<std::string, std::string*> inputs = {{kLeftImage, &topics.left_image},
+                                                      {kLeftInfo, &topics.left_info},
+                                                      {kRightImage, &topics.right_image},
+                                                      {kRightInfo, &topics.right_info},
+                                                      {kCloud, &topics.cloud}};
   if (const auto input = inputs.find(from); input != inputs.end()) {
     *input->second = topic;
     return;
@@ -202,11 +201,10 @@ TimeWindow timeWindow(const std::vector<std::unique_ptr<rosbag::Bag>>& bags,
     throw std::runtime_error("--start " + seconds(start) + " s is past the end of the recording (" +
                              seconds(length) + " s long): no image set to process");
   }
-  throw std::runtime_error(
-      "no image set in the time window " + window + " s: the recording is " + seconds(length) +
-      " s long and its left images on " + left_topic + " lie in [" +
-      seconds((left.getBeginTime() - w.begin).toSec()) + ", " +
-      seconds((left.getEndTime() - w.begin).toSec()) + "] s");
+  throw std::runtime_error("no image set in the time window " + window + " s: the recording is " +
+                           seconds(length) + " s long and its left images on " + left_topic +
+                           " lie in [" + seconds((left.getBeginTime() - w.begin).toSec()) + ", " +
+                           seconds((left.getEndTime() - w.begin).toSec()) + "] s");
 }
 
 }  // namespace lidar_stereo_fusion

@@ -44,10 +44,16 @@ std::string hex(uint64_t v) {
 /// Node parameters that do not change what bag_runner writes (the live node's rate, timing,
 /// monitoring and colour scale). Every other row is in the manifest, new rows included.
 const std::set<std::string>& ignoredNodeParams() {
-  static const std::set<std::string> kIgnored = {
-      "max_rate",      "fresh_wait",          "tf_timeout",  "depth_color_max",
-      "input_timeout", "log_throttle_period", "worker_nice", "diagnostics/min_rate",
-      "diagnostics/max_rate", "diagnostics/max_latency"};
+  static const std::set<std::string> kIgnored = {"max_rate",
+                                                 "fresh_wait",
+                                                 "tf_timeout",
+                                                 "depth_color_max",
+                                                 "input_timeout",
+                                                 "log_throttle_period",
+                                                 "worker_nice",
+                                                 "diagnostics/min_rate",
+                                                 "diagnostics/max_rate",
+                                                 "diagnostics/max_latency"};
   return kIgnored;
 }
 

@@ -167,11 +167,11 @@ void OutputWriter::write(const InputMatch& match, const ros::Time& receipt, cons
   // The depth PNG last: its presence tells --resume that the set is complete.
   if (options_.disparity) {
     writePngAtomically((fs::path(options_.dir) / "disparity" / (name + ".png")).string(),
-                         scaledUint16(set.result.disparity, 256.0));  // KITTI disparity format
+                       scaledUint16(set.result.disparity, 256.0));  // KITTI disparity format
   }
   if (options_.confidence && !set.result.confidence.empty()) {
     writePngAtomically((fs::path(options_.dir) / "confidence" / (name + ".png")).string(),
-                         scaledUint16(set.result.confidence, 65535.0));
+                       scaledUint16(set.result.confidence, 65535.0));
   }
   if (options_.cloud) {
     // The points of points2 (left optical frame, coloured from the left image), x y z rgb, as

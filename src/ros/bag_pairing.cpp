@@ -134,11 +134,11 @@ void BagPairing::finish() {
     const std::string problem = imageProblem(kv.first);
     decided_.push_back(
         {kv.first, kv.second, boost::none,
-         !problem.empty() ? "incomplete image set: " + problem
-                          : std::string("incomplete image set: no right image and camera_infos ") +
-                                (params_.approximate_sync
-                                     ? "near its stamp"
-                                     : "with the same stamp (approximate_sync?)")});
+         !problem.empty()
+             ? "incomplete image set: " + problem
+             : std::string("incomplete image set: no right image and camera_infos ") +
+                   (params_.approximate_sync ? "near its stamp"
+                                             : "with the same stamp (approximate_sync?)")});
   }
   open_.clear();
 }

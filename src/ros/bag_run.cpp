@@ -85,9 +85,9 @@ std::vector<std::string> BagRun::checkPaths() const {
   if (!o_.outputs.out_bag.empty()) outputs.push_back({"--out-bag", o_.outputs.out_bag});
   std::vector<std::string> folders = {o_.outputs.dir,
                                       fs::absolute(o_.frames_csv).parent_path().string()};
-  for (const auto& [asked, sub] : {std::pair{o_.outputs.disparity, "disparity"},
-                                   std::pair{o_.outputs.confidence, "confidence"},
-                                   std::pair{o_.outputs.cloud, "cloud"}}) {
+  for (const auto& [asked, sub] :
+       {std::pair{o_.outputs.disparity, "disparity"},
+        std::pair{o_.outputs.confidence, "confidence"}, std::pair{o_.outputs.cloud, "cloud"}}) {
     if (!asked) continue;
     outputs.push_back({std::string("--") + sub + " folder", (dir / sub).string()});
     folders.push_back((dir / sub).string());
@@ -140,8 +140,7 @@ int BagRun::run() {
   openInputs();
   prepareFolder();
   if (o_.prepare) {
-    std::cout << "bag_runner: " << o_.outputs.dir << " ready (" << window_.sets
-              << " image sets)\n";
+    std::cout << "bag_runner: " << o_.outputs.dir << " ready (" << window_.sets << " image sets)\n";
     return 0;
   }
   return process();
@@ -211,7 +210,8 @@ void BagRun::drain(bool all, FusionPipeline& pipeline, OutputWriter& writer,
 }
 
 void BagRun::printWarnings() {
-  for (const auto& w : pairing_->takeWarnings()) std::cerr << "\nbag_runner: warning: " << w << "\n";
+  for (const auto& w : pairing_->takeWarnings())
+    std::cerr << "\nbag_runner: warning: " << w << "\n";
 }
 
 void BagRun::writeRows() const {
@@ -241,11 +241,10 @@ int BagRun::process() {
           : std::max(window_.begin,
                      window_.from - ros::Duration(std::min(
                                         o_.lead_in, (window_.from - window_.begin).toSec())));
-  const ros::Time read_to =
-      window_.to == ros::TIME_MAX
-          ? ros::TIME_MAX
-          : window_.to +
-                ros::Duration(node_params_.max_sweep_wait + node_params_.max_time_offset + 2.0);
+  const ros::Time read_to = window_.to == ros::TIME_MAX
+                                ? ros::TIME_MAX
+                                : window_.to + ros::Duration(node_params_.max_sweep_wait +
+                                                             node_params_.max_time_offset + 2.0);
   rosbag::View view;
   const std::vector<std::string> inputs = {topics_.left_image,  topics_.left_info,
                                            topics_.right_image, topics_.right_info,
@@ -266,8 +265,8 @@ int BagRun::process() {
       drain(false, pipeline, writer, progress);
     }
   } catch (const std::exception& e) {  // a damaged chunk, a message of the wrong type
-    read_error = "cannot read the recording after bag time " + stampName(pairing_->now()) + ": " +
-                 e.what();
+    read_error =
+        "cannot read the recording after bag time " + stampName(pairing_->now()) + ": " + e.what();
   }
   pairing_->finish();
   drain(true, pipeline, writer, progress);

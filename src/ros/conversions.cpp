@@ -112,7 +112,8 @@ sensor_msgs::ImagePtr decompressImage(const sensor_msgs::CompressedImage& msg) {
     throw ConversionError("cannot decode " + described + ": not a png or jpeg image OpenCV reads");
   }
   if (decoded->image.depth() != CV_8U) {
-    throw ConversionError(described + " decodes to " + std::to_string(decoded->image.elemSize1() * 8) +
+    throw ConversionError(described + " decodes to " +
+                          std::to_string(decoded->image.elemSize1() * 8) +
                           "-bit pixels; the stereo pair must be 8-bit");
   }
   sensor_msgs::ImagePtr out = decoded->toImageMsg();

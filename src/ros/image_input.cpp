@@ -103,8 +103,8 @@ void ImageInput::subscribe(image_transport::ImageTransport& it, ros::NodeHandle&
       compressed_sub_ =
           nh.subscribe(topic + "/" + kCompressed, queue_size, &ImageInput::compressedCb, this);
     } else {
-      image_sub_ = it.subscribe(name_, queue_size, &ImageInput::imageCb, this,
-                                hintsFor("raw", choice, pnh));
+      image_sub_ =
+          it.subscribe(name_, queue_size, &ImageInput::imageCb, this, hintsFor("raw", choice, pnh));
     }
   }
 }

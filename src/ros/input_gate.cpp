@@ -26,12 +26,14 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
       counters_(counters),
       log_(log),
       transport_(chooseTransport(nh, pnh)),
-      sub_left_image_(kLeftImage, [this](const auto& n, const auto& p, const auto& t) {
-        reject(Rejection{n, "decode", p}, t, "image");
-      }),
-      sub_right_image_(kRightImage, [this](const auto& n, const auto& p, const auto& t) {
-        reject(Rejection{n, "decode", p}, t, "image");
-      }),
+      sub_left_image_(kLeftImage,
+                      [this](const auto& n, const auto& p, const auto& t) {
+                        reject(Rejection{n, "decode", p}, t, "image");
+                      }),
+      sub_right_image_(kRightImage,
+                       [this](const auto& n, const auto& p, const auto& t) {
+                         reject(Rejection{n, "decode", p}, t, "image");
+                       }),
       watch_({topicName(kLeftImage), topicName(kLeftInfo), topicName(kRightImage),
               topicName(kRightInfo), topicName(kCloud)},
              params.input_timeout, log),

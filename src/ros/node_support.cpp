@@ -65,9 +65,8 @@ const std::vector<std::string>& inputNames() {
 const std::vector<std::string>& outputNames() {
   // As OutputPublisher::advertise() names them (depth/camera_info with depth/image_rect).
   static const std::vector<std::string> kNames = {
-      "depth/image_rect", "depth/camera_info", "depth/image_color",     "disparity",
-      "points2",          "lidar_disparity",   "disparity_image",       "disparity_image_color",
-      "confidence",       "stats"};
+      "depth/image_rect", "depth/camera_info", "depth/image_color",     "disparity",  "points2",
+      "lidar_disparity",  "disparity_image",   "disparity_image_color", "confidence", "stats"};
   return kNames;
 }
 
@@ -145,12 +144,11 @@ std::vector<std::string> unknownRemaps(const std::map<std::string, std::string>&
     const std::string short_from =
         from.rfind(ns_prefix, 0) == 0 ? from.substr(ns_prefix.size()) : from;
     const std::string nearest = nearestName(short_from, relative);
-    problems.push_back("remap " + from + " := " + to +
-                       " names no topic of this node, so ROS ignores it" +
-                       (nearest.empty() ? "" : " (did you mean " + nearest + "?)") +
-                       "; its inputs: " + joinedNames(inputNames()) +
-                       "; its outputs: " + joinedNames(outputNames()) + " (in " + node_namespace +
-                       ")");
+    problems.push_back(
+        "remap " + from + " := " + to + " names no topic of this node, so ROS ignores it" +
+        (nearest.empty() ? "" : " (did you mean " + nearest + "?)") +
+        "; its inputs: " + joinedNames(inputNames()) +
+        "; its outputs: " + joinedNames(outputNames()) + " (in " + node_namespace + ")");
   }
   return problems;
 }

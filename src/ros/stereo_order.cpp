@@ -48,8 +48,8 @@ StereoOrder infoOrder(const sensor_msgs::CameraInfo& left, const sensor_msgs::Ca
                       std::string* evidence) {
   const double left_tx = left.P[3], right_tx = right.P[3];
   if (evidence != nullptr) {
-    *evidence = "left camera_info P[3] = " + number(left_tx) + ", right camera_info P[3] = " +
-                number(right_tx);
+    *evidence = "left camera_info P[3] = " + number(left_tx) +
+                ", right camera_info P[3] = " + number(right_tx);
   }
   if (left_tx != 0.0 && right_tx == 0.0) return StereoOrder::kSwapped;
   if (left_tx == 0.0 && right_tx != 0.0) return StereoOrder::kInOrder;
@@ -134,16 +134,18 @@ boost::optional<std::string> StereoOrderWatch::conclude(StereoOrder infos, Stere
                                                         const std::string& info_text,
                                                         const std::string& frame_text) {
   const StereoOrder images = images_.verdict();
-  const std::string image_text =
-      "block matching found " + std::to_string(images_.negative) +
-      " pixels at negative disparity and " + std::to_string(images_.positive) + " at positive";
-  const std::string fix = "swap the left and right inputs: left/image_rect_color:=" +
-                          topics_.right_image + " right/image_rect_color:=" + topics_.left_image;
+  const std::string image_text = "block matching found " + std::to_string(images_.negative) +
+                                 " pixels at negative disparity and " +
+                                 std::to_string(images_.positive) + " at positive";
+  const std::string fix =
+      "swap the left and right inputs: left/image_rect_color:=" + topics_.right_image +
+      " right/image_rect_color:=" + topics_.left_image;
   const std::string info_fix =
       "left/camera_info:=" + topics_.right_info + " right/camera_info:=" + topics_.left_info;
   if (images == StereoOrder::kSwapped) {
-    std::string text = "the stereo pair looks swapped (the left topics carry the right camera): " +
-                       image_text + " (a pair in order matches at positive disparity)";
+    std::string text =
+        "the stereo pair looks swapped (the left topics carry the right camera): " + image_text +
+        " (a pair in order matches at positive disparity)";
     if (infos == StereoOrder::kSwapped) text += "; " + info_text + " (the left one should be 0)";
     if (frames == StereoOrder::kSwapped) text += "; " + frame_text;
     // Camera_infos in order (the left one's P[3] is 0) stay; else they go with their images.
@@ -154,9 +156,9 @@ boost::optional<std::string> StereoOrderWatch::conclude(StereoOrder infos, Stere
   if (infos == StereoOrder::kSwapped) {
     return "the camera_infos look swapped: " + info_text +
            " (in the ROS convention the left camera's is 0 and the right one's -fx * baseline)" +
-           (images == StereoOrder::kInOrder ? std::string("; the images are in order (") +
-                                                  image_text + "): " + info_fix
-                                            : "; " + fix + " " + info_fix);
+           (images == StereoOrder::kInOrder
+                ? std::string("; the images are in order (") + image_text + "): " + info_fix
+                : "; " + fix + " " + info_fix);
   }
   if (frames == StereoOrder::kSwapped && images == StereoOrder::kUnknown) {
     return "the stereo pair may be swapped: " + frame_text +

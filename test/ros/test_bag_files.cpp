@@ -6,8 +6,8 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -65,15 +65,13 @@ TEST(BagFiles, AnOutputThatIsAnInputIsRefusedNamingBoth) {
   }
   // The same output twice, one not written yet (compared by path).
   const std::string twice = message([&] {
-    lsf::checkOutputsAgainstInputs(
-        {{"--frames-csv", (dir / "x" / ".." / "rows.csv").string()},
-         {"--out-bag", (dir / "rows.csv").string()}},
-        inputs);
+    lsf::checkOutputsAgainstInputs({{"--frames-csv", (dir / "x" / ".." / "rows.csv").string()},
+                                    {"--out-bag", (dir / "rows.csv").string()}},
+                                   inputs);
   });
   EXPECT_NE(twice.find("are the same file"), std::string::npos) << twice;
   EXPECT_EQ(message([&] {
-              lsf::checkOutputsAgainstInputs({{"--out-bag", (dir / "fused.bag").string()}},
-                                             inputs);
+              lsf::checkOutputsAgainstInputs({{"--out-bag", (dir / "fused.bag").string()}}, inputs);
             }),
             "");
   EXPECT_EQ(fs::file_size(dir / "drive.bag"), 13u);  // nothing written
@@ -116,15 +114,13 @@ TEST(BagFiles, StaleTemporaryFilesOfDeadWritersAreRemoved) {
 TEST(BagFiles, AFolderThatCannotBeWrittenIsNamedWithTheReason) {
   const fs::path dir = scratch("unwritable");
   write(dir / "file", "x");
-  const std::string text = message([&] {
-    lsf::requireWritableFolder((dir / "file").string(), "output");
-  });
+  const std::string text =
+      message([&] { lsf::requireWritableFolder((dir / "file").string(), "output"); });
   EXPECT_NE(text.find("cannot write in " + (dir / "file").string() + " (output): it is a file"),
             std::string::npos)
       << text;
-  const std::string below = message([&] {
-    lsf::requireWritableFolder((dir / "file" / "sub").string(), "output");
-  });
+  const std::string below =
+      message([&] { lsf::requireWritableFolder((dir / "file" / "sub").string(), "output"); });
   EXPECT_NE(below.find("cannot create it: Not a directory"), std::string::npos) << below;
   EXPECT_EQ(message([&] { lsf::requireWritableFolder((dir / "new" / "sub").string(), "o"); }), "");
   EXPECT_TRUE(fs::is_directory(dir / "new" / "sub"));

@@ -202,8 +202,8 @@ TEST(StereoOrder, TheWatchWarnsOnceNamingTheEvidenceAndTheFix) {
   const auto [left, right] = pair(12);
   lsf::StereoOrderWatch watch(kTopics);
   // The topics swapped: the "left" ones carry the right camera (its image, info and frame).
-  const auto warning = watch.observe(set(right, left, -6000.0, 0.0, "right_camera_optical_frame",
-                                         "left_camera_optical_frame"));
+  const auto warning = watch.observe(
+      set(right, left, -6000.0, 0.0, "right_camera_optical_frame", "left_camera_optical_frame"));
   ASSERT_TRUE(warning);
   EXPECT_TRUE(watch.decided());
   for (const char* part :
@@ -244,13 +244,13 @@ TEST(StereoOrder, APairInOrderGivesNoWarningAndAFlatOneNoVerdictAfterItsSets) {
 
 TEST(Remaps, ATypoIsNamedWithTheNearestNameAndKnownNamesPass) {
   const std::map<std::string, std::string> remaps = {
-      {"/fusion/left/image_rect", "/zed/left/image"},                 // typo
-      {"/fusion/left/image_rect_color", "/zed/left/image"},           // input
-      {"/fusion/depth/image_rect", "/out/depth"},                     // output
-      {"/fusion/depth/image_rect/compressed", "/out/depth/c"},        // its transport topic
-      {"/fusion/fusion/parameter_updates", "/elsewhere"},             // private
-      {"/tf", "/tf_old"},                                             // ROS's own
-      {"/velodyne_point", "/vls128/points"}};                         // typo, global
+      {"/fusion/left/image_rect", "/zed/left/image"},           // typo
+      {"/fusion/left/image_rect_color", "/zed/left/image"},     // input
+      {"/fusion/depth/image_rect", "/out/depth"},               // output
+      {"/fusion/depth/image_rect/compressed", "/out/depth/c"},  // its transport topic
+      {"/fusion/fusion/parameter_updates", "/elsewhere"},       // private
+      {"/tf", "/tf_old"},                                       // ROS's own
+      {"/velodyne_point", "/vls128/points"}};                   // typo, global
   const auto problems = lsf::unknownRemaps(remaps, "/fusion", "/fusion/fusion");
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_NE(problems[0].find("remap /fusion/left/image_rect := /zed/left/image names no topic"),
