@@ -37,8 +37,9 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
       watch_({topicName(kLeftImage), topicName(kLeftInfo), topicName(kRightImage),
               topicName(kRightInfo), topicName(kCloud)},
              params.input_timeout, log),
-      order_watch_({topicName(kLeftImage), topicName(kLeftInfo), topicName(kRightImage),
-                    topicName(kRightInfo)}),
+      // The remapped names (without /compressed): what the fix must remap.
+      order_watch_({nh_.resolveName(kLeftImage), nh_.resolveName(kLeftInfo),
+                    nh_.resolveName(kRightImage), nh_.resolveName(kRightInfo)}),
       rate_(params.max_rate),
       fresh_(params.fresh_wait) {
   matcher_.setParams(matcherParams(params_));
