@@ -18,6 +18,8 @@ add_library(${PROJECT_NAME}_ros
   src/ros/node_support.cpp
   src/ros/stereo_sync.cpp
   src/ros/input_gate.cpp
+  src/ros/image_input.cpp
+  src/ros/stereo_order.cpp
   src/ros/input_watch.cpp
   src/ros/frame_input.cpp
   src/ros/output_publisher.cpp

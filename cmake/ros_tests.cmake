@@ -24,7 +24,8 @@ catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp test/ros/test_ros_para
   test/ros/test_input_attacks.cpp
   test/ros/test_point_time.cpp
   test/ros/test_node_parts.cpp test/ros/test_launch_files.cpp test/ros/run_command.cpp
-  test/ros/test_pcl_boundary.cpp)
+  test/ros/test_pcl_boundary.cpp
+  test/ros/test_recordings_node_unit.cpp)
 if(TARGET test_ros_unit)
   # PCL and pcl_conversions: test_pcl_boundary.cpp shows what PCL's conversion does not check.
   target_link_libraries(test_ros_unit ${PROJECT_NAME}_ros ${GTEST_MAIN_LIBRARIES} pcl_common)

@@ -35,12 +35,17 @@ endforeach()
 target_link_libraries(kitti_to_bag ${PROJECT_NAME}_ros)
 
 # bag_runner: the node's pairing (stereo_sync.h) fed from bags; its parts in a library for tests.
-add_library(${PROJECT_NAME}_bag STATIC src/ros/bag_pairing.cpp src/ros/bag_outputs.cpp)
+add_library(${PROJECT_NAME}_bag STATIC src/ros/bag_pairing.cpp src/ros/bag_outputs.cpp
+  src/ros/bag_inputs.cpp src/ros/bag_files.cpp src/ros/bag_manifest.cpp src/ros/bag_run.cpp)
 target_link_libraries(${PROJECT_NAME}_bag PUBLIC ${PROJECT_NAME}_ros)
+# The manifest of an output folder names the package version (package.xml, read by catkin).
+target_compile_definitions(${PROJECT_NAME}_bag PRIVATE
+  LSF_PACKAGE_VERSION="${${PROJECT_NAME}_VERSION}")
 add_executable(bag_runner src/ros/bag_runner.cpp)
 target_link_libraries(bag_runner ${PROJECT_NAME}_bag)
 list(APPEND LSF_ROS_TOOLS bag_runner)
 catkin_install_python(PROGRAMS scripts/lsf_batch DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+install(FILES scripts/lsf_batch_plan.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 install(TARGETS ${LSF_ROS_TOOLS} RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 install(FILES launch/calibration_autoware.launch launch/calibration_kitti.launch

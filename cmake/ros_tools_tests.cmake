@@ -33,6 +33,13 @@ function(lsf_add_tools_rostest target launch_file)
   endif()
 endfunction()
 
+# Issue 33: bag_runner's files (outputs apart from inputs, temporary names, manifest); no master.
+catkin_add_gtest(test_bag_files test/ros/test_bag_files.cpp)
+if(TARGET test_bag_files)
+  lsf_tools_test_setup(test_bag_files)
+  target_link_libraries(test_bag_files ${PROJECT_NAME}_bag ${GTEST_MAIN_LIBRARIES})
+endif()
+
 # Direction and content of the TF / camera_info messages (tf2 buffer, no ROS master).
 catkin_add_gtest(test_calibration_msgs test/ros/test_calibration_msgs.cpp)
 if(TARGET test_calibration_msgs)
@@ -105,3 +112,18 @@ endif()
 catkin_run_tests_target("pytest" "lsf_batch" "pytest-lsf_batch.xml"
   COMMAND "${CMAKE_COMMAND} -E env LSF_DATA_DIR=${LSF_DATA_DIR} LSF_BIN_DIR=$<TARGET_FILE_DIR:bag_runner> LSF_SCRATCH=${CMAKE_CURRENT_BINARY_DIR}/test_lsf_batch ${PYTHON_EXECUTABLE} -m pytest -q -p no:cacheprovider --junitxml=${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-lsf_batch.xml ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_lsf_batch.py"
   DEPENDENCIES bag_runner kitti_to_bag)
+
+# Issue 33: recordings as users keep them (compressed images, outputs apart from inputs, resume
+# with a manifest, a swapped pair, bad bags, empty windows, a lost scheduler, chunk floor, an
+# unwritable folder, the PCD layout) and fusion.launch's box corners; pytest, bags written at
+# test time into the build folder.
+catkin_run_tests_target("pytest" "recordings" "pytest-recordings.xml"
+  COMMAND "${CMAKE_COMMAND} -E env LSF_DATA_DIR=${LSF_DATA_DIR} LSF_BIN_DIR=$<TARGET_FILE_DIR:bag_runner> LSF_SCRATCH=${CMAKE_CURRENT_BINARY_DIR}/test_recordings ${PYTHON_EXECUTABLE} -m pytest -q -p no:cacheprovider --junitxml=${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-recordings.xml ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_recordings.py"
+  DEPENDENCIES bag_runner kitti_to_bag)
+
+# Issue 33, the live node: playback.launch image_transport:=compressed on compressed KITTI bags
+# (png: the raw depth, jpeg: within the stated tolerance), a transport without its plugin, a
+# swapped pair, a remap naming nothing of the node; pytest with its own roscore.
+catkin_run_tests_target("pytest" "recordings_node" "pytest-recordings_node.xml"
+  COMMAND "${CMAKE_COMMAND} -E env LSF_DATA_DIR=${LSF_DATA_DIR} LSF_BIN_DIR=$<TARGET_FILE_DIR:bag_runner> LSF_SCRATCH=${CMAKE_CURRENT_BINARY_DIR}/test_recordings_node ${PYTHON_EXECUTABLE} -m pytest -q -p no:cacheprovider --junitxml=${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-recordings_node.xml ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_recordings_node.py"
+  DEPENDENCIES bag_runner kitti_to_bag fusion_node ${PROJECT_NAME}_ros)

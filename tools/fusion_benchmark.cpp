@@ -5,12 +5,14 @@
 // left view, which the pipeline's rows sum over both views.
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -39,7 +41,8 @@ Times every stage of the fusion on one frame and OpenCV's StereoSGBM (MODE_SGBM_
 disparities, block 5, the same thread count) on the same pair, alternating, after one warm-up
 run of each; prints the median [ms] per stage, SGBM's median and the ratio fused / SGBM (median
 of the per-repetition ratios); then the LiDAR stages alone on the left view (ring recovery by
-sweep order, projection, BI* and BF* up-sampling), median [ms] each.
+sweep order and, on the sweep shuffled, by the beam model; projection, BI* and BF* up-sampling),
+median [ms] each.
 
 Options:
   --kitti-raw <dir>  the KITTI drive (default: the shared data's drive 0009, found from the
@@ -187,8 +190,12 @@ void printStages(const Timing& t) {
 /// data test TimingOfProjectionAndUpsampling; the aim: projection + BI* < 30 ms, BF* well under
 /// 100 ms on KITTI).
 void printLidarStages(const Case& c, const lsf::FusionParams& params, int repeat) {
-  std::vector<double> rings, projection, bi, bf;
+  std::vector<double> rings, beams, projection, bi, bf;
+  lsf::LidarCloud shuffled = c.input.cloud;  // a sweep whose order says nothing (issue 31)
+  std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(1));
   for (int i = 0; i < repeat; ++i) {
+    lsf::LidarCloud any_order = shuffled;
+    beams.push_back(timeMs([&] { lsf::recoverRingsByBeamModel(any_order, 128); }));
     lsf::LidarCloud cloud = c.input.cloud;
     rings.push_back(timeMs([&] { lsf::recoverRingsBySweepOrder(cloud); }));
     lsf::SparseDisparity sparse;
@@ -202,6 +209,7 @@ void printLidarStages(const Case& c, const lsf::FusionParams& params, int repeat
   for (int i = 0; i < repeat; ++i) projection_bi.push_back(projection[i] + bi[i]);
   std::printf("\n| %-38s | %9s |\n|---|---|\n", "LiDAR stage alone, left view (median)", "ms");
   printRow("ring recovery by sweep order", lsf::median(rings));
+  printRow("ring recovery by beam model (shuffled)", lsf::median(beams));
   printRow("projection", lsf::median(projection));
   printRow("BI* up-sampling", lsf::median(bi));
   printRow("projection + BI*", lsf::median(projection_bi));

@@ -148,6 +148,13 @@ int fillPriorHoles(cv::Mat1f& prior, cv::Mat1f& confidence, const PriorConfidenc
     while (y >= 0 && !(prior(y, x) > 0.f)) --y;
     for (int v = y + 1; y >= 0 && v < prior.rows; ++v) set(v, x, prior(y, x));
   }
+  // Columns: above the top value, that value for top_extension_rows rows.
+  for (int x = 0; x < prior.cols; ++x) {
+    int y = 0;
+    while (y < prior.rows && !(prior(y, x) > 0.f)) ++y;
+    if (y == prior.rows) continue;
+    for (int v = std::max(0, y - params.top_extension_rows); v < y; ++v) set(v, x, prior(y, x));
+  }
   return filled;
 }
 

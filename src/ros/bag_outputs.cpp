@@ -1,18 +1,16 @@
 #include "lidar_stereo_fusion/ros/bag_outputs.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "lidar_stereo_fusion/core/depth.h"
-#include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/pcd.h"
+#include "lidar_stereo_fusion/ros/bag_files.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
 #include "lidar_stereo_fusion/ros/frame_input.h"
 #include "lidar_stereo_fusion/ros/output_publisher.h"
@@ -40,13 +38,16 @@ std::string csvField(const std::string& text) {
   return out + "\"";
 }
 
-/// A temporary name beside `path` (same folder, so the rename is atomic).
-std::string tempPath(const std::string& path) { return path + ".tmp" + std::to_string(::getpid()); }
-
-void writeImageAtomically(const std::string& path, const cv::Mat& image) {
-  const std::string tmp = tempPath(path) + ".png";
-  if (!cv::imwrite(tmp, image)) throw std::runtime_error("cannot write " + tmp);
-  fs::rename(tmp, path);
+/// A PNG encoded in memory and written through a temporary name (bag_files.h): the temporary
+/// file never ends in .png, and a failure names the reason.
+void writePngAtomically(const std::string& path, const cv::Mat& image) {
+  std::vector<uchar> bytes;
+  try {
+    if (!cv::imencode(".png", image, bytes)) throw std::runtime_error("the encoder refused it");
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error("cannot encode " + path + ": " + e.what());
+  }
+  writeBytesAtomically(path, std::string(bytes.begin(), bytes.end()));
 }
 
 /// [0, 1] (or px) * scale as uint16, 0 = none (negative, NaN).
@@ -108,13 +109,7 @@ std::string notOkRow(const ros::Time& stamp, const std::string& status, const st
 }
 
 void writeFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = tempPath(path);
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    if (!out.flush()) throw std::runtime_error("cannot write " + tmp);
-  }
-  fs::rename(tmp, path);
+  writeBytesAtomically(path, text);
 }
 
 OutputWriter::OutputWriter(const OutputOptions& options, const NodeParams& node_params)
@@ -123,25 +118,41 @@ OutputWriter::OutputWriter(const OutputOptions& options, const NodeParams& node_
   if (options_.disparity) fs::create_directories(fs::path(options_.dir) / "disparity");
   if (options_.confidence) fs::create_directories(fs::path(options_.dir) / "confidence");
   if (options_.cloud) fs::create_directories(fs::path(options_.dir) / "cloud");
-  if (!options_.out_bag.empty()) {
-    bag_ = std::make_unique<rosbag::Bag>(options_.out_bag, rosbag::bagmode::Write);
+  if (!options_.out_bag.empty()) {  // renamed into place by close()
+    bag_ = std::make_unique<rosbag::Bag>(tempPath(options_.out_bag), rosbag::bagmode::Write);
   }
 }
 
 OutputWriter::~OutputWriter() {
+  // Not closed: an error ends the run, and the unfinished --out-bag stays under its temporary
+  // name, which the next run removes.
   try {
-    close();
-  } catch (...) {  // a destructor must not throw; close() reports when called explicitly
+    if (bag_) bag_->close();
+  } catch (...) {  // a destructor must not throw
   }
 }
 
 void OutputWriter::close() {
-  if (bag_) bag_->close();
+  if (!bag_) return;
+  bag_->close();
   bag_.reset();
+  fs::rename(tempPath(options_.out_bag), options_.out_bag);
 }
 
 std::string OutputWriter::depthPath(const ros::Time& stamp) const {
   return (fs::path(options_.dir) / (stampName(stamp) + ".png")).string();
+}
+
+std::string OutputWriter::cloudPath(const ros::Time& stamp) const {
+  return (fs::path(options_.dir) / "cloud" / (stampName(stamp) + ".pcd")).string();
+}
+
+bool OutputWriter::complete(const ros::Time& stamp) const {
+  std::error_code ec;
+  const std::string name = stampName(stamp) + ".png";
+  return fs::exists(depthPath(stamp), ec) &&
+         (!options_.disparity || fs::exists(fs::path(options_.dir) / "disparity" / name, ec)) &&
+         (!options_.cloud || fs::exists(cloudPath(stamp), ec));
 }
 
 std::string OutputWriter::topic(const std::string& relative) const {
@@ -155,30 +166,23 @@ void OutputWriter::write(const InputMatch& match, const ros::Time& receipt, cons
   const std::string name = stampName(match.image_stamp);
   // The depth PNG last: its presence tells --resume that the set is complete.
   if (options_.disparity) {
-    writeImageAtomically((fs::path(options_.dir) / "disparity" / (name + ".png")).string(),
-                         scaledUint16(set.result.disparity, 256.0));  // KITTI disparity format
+    writePngAtomically((fs::path(options_.dir) / "disparity" / (name + ".png")).string(),
+                       scaledUint16(set.result.disparity, 256.0));  // KITTI disparity format
   }
   if (options_.confidence && !set.result.confidence.empty()) {
-    writeImageAtomically((fs::path(options_.dir) / "confidence" / (name + ".png")).string(),
-                         scaledUint16(set.result.confidence, 65535.0));
+    writePngAtomically((fs::path(options_.dir) / "confidence" / (name + ".png")).string(),
+                       scaledUint16(set.result.confidence, 65535.0));
   }
   if (options_.cloud) {
-    LidarCloud points;  // left optical frame; intensity = grey value of the left image
-    for (const ColoredPoint& p : makeColoredCloud(set.depth, set.left, set.camera)) {
-      LidarPoint q;
-      q.x = p.x;
-      q.y = p.y;
-      q.z = p.z;
-      q.intensity = (p.r + p.g + p.b) / 3.f;
-      points.push_back(q);
-    }
-    const std::string path = (fs::path(options_.dir) / "cloud" / (name + ".pcd")).string();
-    pcd::writePcd(tempPath(path), points);
+    // The points of points2 (left optical frame, coloured from the left image), x y z rgb, as
+    // kitti_runner --save-pcd writes them.
+    const std::string path = cloudPath(match.image_stamp);
+    pcd::writeColoredPcd(tempPath(path), makeColoredCloud(set.depth, set.left, set.camera));
     fs::rename(tempPath(path), path);
   }
-  const std::string depth_path = depthPath(match.image_stamp);
-  kitti::writeDepthPng(tempPath(depth_path) + ".png", set.depth);
-  fs::rename(tempPath(depth_path) + ".png", depth_path);
+  // KITTI depth format: metres * 256 rounded, clamped to [1, 65535], 0 = none (as
+  // kitti::writeDepthPng, encoded here to go through a temporary name).
+  writePngAtomically(depthPath(match.image_stamp), scaledUint16(set.depth, 256.0));
 
   if (!bag_) return;
   // The node's output topics, stamped as their inputs, at the left image's bag time.

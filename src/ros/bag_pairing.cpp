@@ -5,8 +5,11 @@
 #include <utility>
 
 #include <ros/message_event.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <tf2_msgs/TFMessage.h>
 #include <boost/bind/bind.hpp>
+
+#include "lidar_stereo_fusion/ros/conversions.h"
 
 namespace lidar_stereo_fusion {
 
@@ -14,6 +17,8 @@ namespace {
 
 /// Longer than any drive's lead-in: lookups are made shortly after the sweep was read.
 constexpr double kTfCacheSeconds = 60.0;
+/// Undecodable images remembered, to name them in the reason of their set.
+constexpr std::size_t kMaxImageProblems = 64;
 
 std::string seconds(double s) {
   char text[32];
@@ -30,7 +35,10 @@ std::string stampName(const ros::Time& t) {
 }
 
 BagPairing::BagPairing(const NodeParams& params, const BagTopics& topics)
-    : params_(params), topics_(topics), tf_(ros::Duration(kTfCacheSeconds)) {
+    : params_(params),
+      topics_(topics),
+      tf_(ros::Duration(kTfCacheSeconds)),
+      order_watch_({topics.left_image, topics.left_info, topics.right_image, topics.right_info}) {
   matcher_.setParams(matcherParams(params_));
   using boost::placeholders::_1;
   using boost::placeholders::_2;
@@ -58,8 +66,8 @@ void BagPairing::add(const rosbag::MessageInstance& m) {
   InputMatcher::Events polled = matcher_.poll(now_);
   handle(polled);
   if (topic == topics_.left_image || topic == topics_.right_image) {
-    const auto image = m.instantiate<Image>();
-    if (!image) throw std::runtime_error(topic + " holds " + m.getDataType() + ", not an Image");
+    const auto image = this->image(m);
+    if (!image) return;  // undecodable: its set is skipped with the reason
     if (topic == topics_.left_image) {
       open_.emplace(image->header.stamp, now_);
       left_image_.add(ros::MessageEvent<const Image>(image, now_));
@@ -87,17 +95,50 @@ void BagPairing::add(const rosbag::MessageInstance& m) {
   }
 }
 
+sensor_msgs::ImageConstPtr BagPairing::image(const rosbag::MessageInstance& m) {
+  const std::string& topic = m.getTopic();
+  if (m.getDataType() != "sensor_msgs/CompressedImage") {
+    const auto image = m.instantiate<Image>();
+    if (!image) {
+      throw std::runtime_error(topic + " holds " + m.getDataType() +
+                               ", not a sensor_msgs/Image or CompressedImage");
+    }
+    return image;
+  }
+  const auto compressed = m.instantiate<sensor_msgs::CompressedImage>();
+  if (!compressed) throw std::runtime_error(topic + ": unreadable sensor_msgs/CompressedImage");
+  try {
+    return conversions::decompressImage(*compressed);
+  } catch (const conversions::ConversionError& e) {
+    const ros::Time& stamp = compressed->header.stamp;
+    if (image_problems_.size() >= kMaxImageProblems) image_problems_.erase(image_problems_.begin());
+    image_problems_[stamp] = topic + ": " + e.what();
+    if (topic == topics_.left_image) {  // its set is known by the left stamp alone
+      decided_.push_back({stamp, now_, boost::none, image_problems_[stamp]});
+    }
+    return nullptr;
+  }
+}
+
+std::string BagPairing::imageProblem(const ros::Time& stamp) const {
+  const auto it = image_problems_.find(stamp);
+  return it == image_problems_.end() ? "" : it->second;
+}
+
 void BagPairing::finish() {
   // Far enough in the future that every waiting set has waited ~max_sweep_wait.
   const ros::Time end = now_ + ros::Duration(params_.max_sweep_wait + 1.0);
   InputMatcher::Events events = matcher_.poll(end);
   handle(events);
   for (const auto& kv : open_) {  // never completed by the synchroniser
+    const std::string problem = imageProblem(kv.first);
     decided_.push_back(
         {kv.first, kv.second, boost::none,
-         std::string("incomplete image set: no right image and camera_infos ") +
-             (params_.approximate_sync ? "near its stamp"
-                                       : "with the same stamp (approximate_sync?)")});
+         !problem.empty()
+             ? "incomplete image set: " + problem
+             : std::string("incomplete image set: no right image and camera_infos ") +
+                   (params_.approximate_sync ? "near its stamp"
+                                             : "with the same stamp (approximate_sync?)")});
   }
   open_.clear();
 }
@@ -116,6 +157,9 @@ void BagPairing::onSet(const sensor_msgs::ImageConstPtr& left,
   if (const auto rejection = checkImageSet(set)) {
     return skip(stamp, rejection->topic + ": " + rejection->problem);
   }
+  if (!order_watch_.decided()) {
+    if (auto warning = order_watch_.observe(set)) warnings_.push_back(std::move(*warning));
+  }
   InputMatcher::Events events = matcher_.addImages(stamp, std::move(set), now_);
   if (events.out_of_order) {
     skip(stamp, "stamp not newer than the previous image set's (out of order or duplicate)");
@@ -128,6 +172,8 @@ void BagPairing::onDrop(const sensor_msgs::ImageConstPtr& left,
                         const sensor_msgs::ImageConstPtr& right,
                         const sensor_msgs::CameraInfoConstPtr& right_info) {
   if (!left) return;  // no set of ours: a lone right image or camera_info
+  const std::string problem = imageProblem(left->header.stamp);
+  if (!problem.empty()) return skip(left->header.stamp, "incomplete image set: " + problem);
   std::string missing;
   if (!left_info) missing += " " + topics_.left_info;
   if (!right) missing += " " + topics_.right_image;

@@ -92,6 +92,35 @@ cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg) {
   return out;
 }
 
+sensor_msgs::ImagePtr decompressImage(const sensor_msgs::CompressedImage& msg) {
+  const std::string described = "compressed image (format '" + msg.format + "', " +
+                                std::to_string(msg.data.size()) + " bytes)";
+  // cv_bridge reads data[0] unchecked, and cannot read the 12-byte header of compressedDepth.
+  if (msg.data.empty()) throw ConversionError("empty " + described);
+  if (msg.format.find("compressedDepth") != std::string::npos) {
+    throw ConversionError(described + " is a compressedDepth depth map, not a camera image");
+  }
+  cv_bridge::CvImagePtr decoded;
+  try {
+    decoded = cv_bridge::toCvCopy(msg);
+  } catch (const cv_bridge::Exception& e) {
+    throw ConversionError("cannot decode " + described + ": cv_bridge: " + e.what());
+  } catch (const cv::Exception& e) {
+    throw ConversionError("cannot decode " + described + ": OpenCV: " + e.what());
+  }
+  if (!decoded || decoded->image.empty()) {
+    throw ConversionError("cannot decode " + described + ": not a png or jpeg image OpenCV reads");
+  }
+  if (decoded->image.depth() != CV_8U) {
+    throw ConversionError(described + " decodes to " +
+                          std::to_string(decoded->image.elemSize1() * 8) +
+                          "-bit pixels; the stereo pair must be 8-bit");
+  }
+  sensor_msgs::ImagePtr out = decoded->toImageMsg();
+  out->header = msg.header;
+  return out;
+}
+
 void stereoPairToCore(const sensor_msgs::ImageConstPtr& left,
                       const sensor_msgs::ImageConstPtr& right, cv::Mat& left_out,
                       cv::Mat& right_out, std::string* note) {

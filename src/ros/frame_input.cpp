@@ -71,7 +71,8 @@ bool rejectEmptySweep(const InputMatch& match, const conversions::CloudConversio
 void recoverRings(const InputMatch& match, const NodeParams& params, const std::string& cloud_topic,
                   conversions::CloudConversion& cloud, PreparedFrame& frame) {
   FrameReport& report = frame.report;
-  // The ring field if plausible, else the offline sweep-order rule, else elevation; each checked.
+  // The ring field if plausible, else the offline sweep-order rule, else the beams found in the
+  // cloud (beam model), else elevation bands; each checked (core/ring_recovery.h).
   report.rings = ensureRings(cloud.cloud, cloud.has_ring, params.num_rings);
   if (!report.rings.plausible) {
     frame.notes.push_back(
@@ -79,8 +80,9 @@ void recoverRings(const InputMatch& match, const NodeParams& params, const std::
                       stampText(match.sweep_stamp) + " (" + report.rings.fallbacks + "); using " +
                       std::to_string(report.rings.rings) + " rings by " +
                       ringSourceName(report.rings.source) +
-                      ", the prior will be coarse (publish the driver's ring field, or set "
-                      "~num_rings to the sensor's beam count)"});
+                      ", the prior will be coarse (a LiDAR without scan lines gives this; else "
+                      "publish the driver's ring field, or set ~num_rings to the sensor's beam "
+                      "count)"});
   }
   report.point_time_field = conversions::pointTimeFieldName(cloud.time_field);
   report.bad_times = cloud.bad_times;

@@ -25,12 +25,28 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
       params_(params),
       counters_(counters),
       log_(log),
+      transport_(chooseTransport(nh, pnh)),
+      sub_left_image_(kLeftImage,
+                      [this](const auto& n, const auto& p, const auto& t) {
+                        reject(Rejection{n, "decode", p}, t, "image");
+                      }),
+      sub_right_image_(kRightImage,
+                       [this](const auto& n, const auto& p, const auto& t) {
+                         reject(Rejection{n, "decode", p}, t, "image");
+                       }),
       watch_({topicName(kLeftImage), topicName(kLeftInfo), topicName(kRightImage),
               topicName(kRightInfo), topicName(kCloud)},
              params.input_timeout, log),
+      // The remapped names (without /compressed): what the fix must remap.
+      order_watch_({nh_.resolveName(kLeftImage), nh_.resolveName(kLeftInfo),
+                    nh_.resolveName(kRightImage), nh_.resolveName(kRightInfo)}),
       rate_(params.max_rate),
       fresh_(params.fresh_wait) {
   matcher_.setParams(matcherParams(params_));
+  if (!transport_.note.empty()) {
+    log_.log(transport_.error ? ThrottledLog::Level::kError : ThrottledLog::Level::kInfo,
+             "image_transport", "transport", transport_.note);
+  }
 
   // Synchroniser of the image set (connected once; the filters are (un)subscribed lazily).
   it_ = std::make_shared<image_transport::ImageTransport>(nh_);
@@ -64,11 +80,11 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
       watch_.check([this](std::size_t i) -> uint32_t {
         switch (i) {
           case 0:
-            return sub_left_image_.getSubscriber().getNumPublishers();
+            return sub_left_image_.getNumPublishers();
           case 1:
             return sub_left_info_.getSubscriber().getNumPublishers();
           case 2:
-            return sub_right_image_.getSubscriber().getNumPublishers();
+            return sub_right_image_.getNumPublishers();
           case 3:
             return sub_right_info_.getSubscriber().getNumPublishers();
           default:
@@ -84,12 +100,18 @@ InputGate::~InputGate() {
   stop();
 }
 
+std::string InputGate::topicName(const std::string& relative) const {
+  if (relative == kLeftImage || relative == kRightImage) {
+    return ImageInput::subscribedTopic(nh_, relative, transport_);
+  }
+  return nh_.resolveName(relative);
+}
+
 void InputGate::subscribe() {
-  const image_transport::TransportHints hints("raw", ros::TransportHints(), pnh_);
   const uint32_t q = static_cast<uint32_t>(params_.queue_size);
-  sub_left_image_.subscribe(*it_, kLeftImage, q, hints);
+  sub_left_image_.subscribe(*it_, nh_, pnh_, q, transport_);
   sub_left_info_.subscribe(nh_, kLeftInfo, q);
-  sub_right_image_.subscribe(*it_, kRightImage, q, hints);
+  sub_right_image_.subscribe(*it_, nh_, pnh_, q, transport_);
   sub_right_info_.subscribe(nh_, kRightInfo, q);
   sub_cloud_ = nh_.subscribe(kCloud, 2, &InputGate::cloudCb, this);
   subscribed_ = true;
@@ -259,10 +281,20 @@ void InputGate::imageCb(const sensor_msgs::ImageConstPtr& left,
   set.arrival_wall = std::chrono::steady_clock::now();
   set.clock_epoch = clock_epoch_;
   if (const auto rejection = checkImageSet(set)) return reject(*rejection, stamp, "image set");
+  checkStereoOrder(set);
   std::lock_guard<std::mutex> lock(mutex_);
   detectClockJump();
   InputMatcher::Events events = matcher_.addImages(stamp, std::move(set), ros::Time::now());
   handleEvents(events, kLeftImage, stamp);
+}
+
+void InputGate::checkStereoOrder(const ImageSet& set) {
+  // A few ms on each of the first sets only; a callback busy with it is not waited for.
+  std::unique_lock<std::mutex> lock(order_mutex_, std::try_to_lock);
+  if (!lock.owns_lock() || order_watch_.decided()) return;
+  if (const auto warning = order_watch_.observe(set)) {
+    log_.warn(kLeftImage, "swapped", *warning);
+  }
 }
 
 void InputGate::syncDropCb(const sensor_msgs::ImageConstPtr& left,

@@ -134,6 +134,7 @@ TEST(FillPriorHoles, RowGapsTakeTheNearerEndRowEndsAndTheBottomAreExtended) {
   prior(1, 4) = 8.f;
   conf(1, 1) = conf(1, 4) = 1.f;
   lsf::PriorConfidenceParams p;
+  p.top_extension_rows = 0;  // FillPriorHoles.ExtendsEachColumnsTopValueUp covers it
   const int filled = lsf::fillPriorHoles(prior, conf, p);
   const float row1[6] = {5.f, 5.f, 8.f, 8.f, 8.f, 8.f};
   for (int x = 0; x < 6; ++x) {
@@ -158,6 +159,7 @@ TEST(FillPriorHoles, ARowFillNeverCarriesANearerValueAboveAColumnsTop) {
     for (int y = 3; y < 5; ++y) prior(y, x) = 20.f;
   }
   lsf::PriorConfidenceParams p;
+  p.top_extension_rows = 0;
   lsf::fillPriorHoles(prior, conf, p);
   for (int x = 1; x < 6; ++x) {
     EXPECT_EQ(prior(0, x), 0.f) << "no near band above the facade's top, column " << x;
@@ -166,6 +168,30 @@ TEST(FillPriorHoles, ARowFillNeverCarriesANearerValueAboveAColumnsTop) {
   EXPECT_EQ(prior(2, 3), 13.f) << "the facade seen beside a dropout fills it (not nearer)";
   EXPECT_FLOAT_EQ(conf(2, 3), 0.2f);
   EXPECT_EQ(prior(2, 1), 13.f) << "measured values stay";
+}
+
+TEST(FillPriorHoles, ExtendsEachColumnsTopValueUpByTopExtensionRows) {
+  // Column 0: a near pole from row 2 (40 px); column 1: a far facade from row 5 (13 px); column
+  // 2: no LiDAR at all.
+  cv::Mat1f prior = cv::Mat1f::zeros(8, 3);
+  cv::Mat1f conf = cv::Mat1f::zeros(8, 3);
+  for (int y = 2; y < 8; ++y) prior(y, 0) = 40.f;
+  for (int y = 5; y < 8; ++y) prior(y, 1) = 13.f;
+  lsf::PriorConfidenceParams p;
+  p.top_extension_rows = 3;
+  const int filled = lsf::fillPriorHoles(prior, conf, p);
+  // The row fill gives column 1 nothing nearer than its top (13 px) above row 5, and column 2
+  // the row's last value (40 in rows 2-4, 13 in rows 5-7); then each column's top value goes up
+  // 3 rows (column 2's filled one too).
+  const float expected[8][3] = {{40, 0, 40},  {40, 0, 40},  {40, 13, 40}, {40, 13, 40},
+                                {40, 13, 40}, {40, 13, 13}, {40, 13, 13}, {40, 13, 13}};
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 3; ++x) EXPECT_EQ(prior(y, x), expected[y][x]) << x << "," << y;
+  }
+  EXPECT_FLOAT_EQ(conf(1, 0), 0.2f);
+  EXPECT_FLOAT_EQ(conf(2, 1), 0.2f);
+  EXPECT_EQ(conf(2, 0), 0.f) << "measured values keep their confidence";
+  EXPECT_EQ(filled, 6 + 2 + 3 + 2);  // rows, then the three columns' extensions
 }
 
 TEST(FillPriorHoles, ZeroHoleConfidenceFillsNothing) {

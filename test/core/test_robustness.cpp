@@ -143,8 +143,8 @@ LidarCloud sweepOrderCloud(int lasers, int per_laser) {
 }
 
 // Point 6: a sweep without rings (kitti2bag) gets its rings by sweep order as offline; a ring
-// field that is all 0 is not believed; a shuffled sweep falls back to elevation and never
-// reaches the 32767-ring limit of the ring map.
+// field that is all 0 is not believed; a shuffled sweep falls back to the beam model (issue 31)
+// and never reaches the 32767-ring limit of the ring map.
 TEST(Robustness, RingRecoveryFallsBackExplicitlyAndChecksPlausibility) {
   LidarCloud cloud = sweepOrderCloud(64, 500);
   RingRecovery r = ensureRings(cloud, false, 64);
@@ -174,7 +174,7 @@ TEST(Robustness, RingRecoveryFallsBackExplicitlyAndChecksPlausibility) {
   std::mt19937 rng(7);
   std::shuffle(shuffled.begin(), shuffled.end(), rng);
   r = ensureRings(shuffled, false, 64);
-  EXPECT_EQ(r.source, RingSource::kElevation) << "seed 7";
+  EXPECT_EQ(r.source, RingSource::kBeamModel) << "seed 7";
   EXPECT_EQ(r.rings, 64);
   EXPECT_TRUE(r.plausible) << r.fallbacks;
   EXPECT_NE(r.fallbacks.find("sweep order: "), std::string::npos) << r.fallbacks;
@@ -189,11 +189,14 @@ TEST(Robustness, RingRecoveryFallsBackExplicitlyAndChecksPlausibility) {
   T.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
   EXPECT_NO_THROW(projectCloud(shuffled, T, camera, ProjectionParams()));
 
-  // Elevation that cannot separate the beams: flagged as implausible, used anyway.
+  // One beam: the beam model and elevation find one ring; flagged as implausible, used anyway.
   LidarCloud flat = sweepOrderCloud(1, 2000);
   std::shuffle(flat.begin(), flat.end(), rng);
   r = ensureRings(flat, false, 64);
   EXPECT_FALSE(r.plausible);
+  EXPECT_EQ(r.rings, 1);
+  EXPECT_NE(r.fallbacks.find("beam model: 1 beam line for 2000 points"), std::string::npos)
+      << r.fallbacks;
   EXPECT_NE(r.fallbacks.find("elevation: "), std::string::npos) << r.fallbacks;
   EXPECT_THROW(ensureRings(flat, false, 0), std::invalid_argument);
 }

@@ -94,6 +94,9 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PriorConfidenceParams>> visitPa
   v(ParamSpec{"hole_confidence", g, within(0, 1), "",
               "Confidence of the fused method's hole fill inside the LiDAR's view (0 = no fill)"},
     p.hole_confidence);
+  v(ParamSpec{"top_extension_rows", g, atLeast(0), "rows",
+              "The hole fill extends each column's top value this far up, at hole_confidence"},
+    p.top_extension_rows);
 }
 
 template <class P, class V>

@@ -42,6 +42,11 @@ struct PriorConfidenceParams {
   double decay_rows = 16.0;        ///< [rows] e-folding distance beyond near_rows; 0 = no decay
   /// Confidence of the hole fill (fillPriorHoles); 0 = no fill.
   double hole_confidence = 0.2;
+  /// [rows] The hole fill extends each column's top value this far up (0 = not at all): above
+  /// the top scan line the surface it hit most often goes on (facades, trees, poles), as
+  /// IP-Basic's extension to the top assumes; about one ring spacing of a 64-beam LiDAR at mid
+  /// range, at hole_confidence so that the images decide.
+  int top_extension_rows = 6;
   void validate() const;
 };
 
@@ -53,17 +58,19 @@ cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
                           const std::vector<cv::Point>& removed,
                           const PriorConfidenceParams& params);
 
-/// Fills the holes of the prior inside the LiDAR's field of view for the fused method: within a
-/// row, a gap between two prior values takes the nearer of the two (the larger disparity), as the
-/// KITTI devkit's interpolateBackground does for the benchmark, and the row ends take the first /
-/// last value; below the bottom value of a column, that value. Rows without a value and pixels
-/// above the top value of their own column (beyond the LiDAR's field of view there; a row fill
-/// never crosses it, so a near object's top points do not spread over the far surfaces beside and
-/// above them) stay empty. Filled pixels get
-/// confidence params.hole_confidence: a weak pull that decides where the images cannot (a dark,
-/// textureless car body that returned few LiDAR points) and yields to them where they can. Nothing
-/// happens when hole_confidence is 0. Returns the number of pixels filled. Throws
-/// std::invalid_argument for maps of different sizes.
+/// Fills the holes of the prior inside the LiDAR's field of view for the fused method:
+///  * rows: a gap between two prior values takes the nearer of the two (the larger disparity), as
+///    the KITTI devkit's interpolateBackground does for the benchmark, and the row ends take the
+///    first / last value; but above a column's own top value only a value no nearer than that top
+///    (+ edge_tolerance) is put (a near object's top points sit higher in the image than a far
+///    surface's, and would otherwise spread along the row over the far surfaces above the scan
+///    lines: a band of near planes);
+///  * columns: below the bottom value, that value; above the top value, that value for
+///    params.top_extension_rows rows.
+/// Rows without a value stay empty. Filled pixels get confidence params.hole_confidence: a weak
+/// pull that decides where the images cannot (a dark, textureless car body that returned few LiDAR
+/// points) and yields to them where they can. Nothing happens when hole_confidence is 0. Returns
+/// the number of pixels filled. Throws std::invalid_argument for maps of different sizes.
 int fillPriorHoles(cv::Mat1f& prior, cv::Mat1f& confidence, const PriorConfidenceParams& params);
 
 }  // namespace lidar_stereo_fusion

@@ -59,8 +59,9 @@ std::vector<Frame> listFrames(const std::string& drive_dir,
 struct FrameData {
   cv::Mat left, right;  ///< BGR CV_8UC3 rectified image_02 / image_03
   LidarCloud cloud;     ///< the sweep, rings recovered by sweep order (0..63 on the HDL-64E)
-  /// How the rings were recovered: sweep order when plausible (every KITTI .bin), else elevation
-  /// (a shuffled sweep); `rings.plausible` false when neither looks like a scan pattern.
+  /// How the rings were recovered: sweep order when plausible (every KITTI .bin), else the beam
+  /// model (a shuffled sweep), else elevation; `rings.plausible` false when none looks like a scan
+  /// pattern.
   RingRecovery rings;
 };
 /// Reads a frame. 8-bit images are used as they are; 16-bit PNGs are scaled to 8 bits (value *

@@ -57,13 +57,19 @@ std::string okRow(const ros::Time& stamp, const InputMatch& match, const FusedSe
 std::string notOkRow(const ros::Time& stamp, const std::string& status, const std::string& reason);
 
 /// Writes the files of one set (each to a temporary name, then renamed: a killed run leaves no
-/// half-written file) and, with --out-bag, its messages.
+/// half-written file; bag_files.h) and, with --out-bag, its messages (into a temporary bag renamed
+/// by close()). The PCDs of --cloud have the layout of points2 and kitti_runner --save-pcd.
 class OutputWriter {
  public:
   OutputWriter(const OutputOptions& options, const NodeParams& node_params);
   ~OutputWriter();
   /// DIR/<stamp>.png: the depth PNG of the set stamped `stamp`.
   std::string depthPath(const ros::Time& stamp) const;
+  /// DIR/cloud/<stamp>.pcd.
+  std::string cloudPath(const ros::Time& stamp) const;
+  /// Whether every file asked for the set stamped `stamp` exists (the depth PNG, and the
+  /// disparity PNG and PCD when asked; a set without confidence writes none): --resume keeps it.
+  bool complete(const ros::Time& stamp) const;
   void write(const InputMatch& match, const ros::Time& receipt, const FusedSet& set,
              const FusionParams& params);
   void close();
@@ -75,7 +81,7 @@ class OutputWriter {
   std::unique_ptr<rosbag::Bag> bag_;
 };
 
-/// Writes `text` to `path` through a temporary file and a rename. Throws naming the path.
+/// Writes `text` to `path` through a temporary file and a rename. Throws naming the path and why.
 void writeFileAtomically(const std::string& path, const std::string& text);
 
 }  // namespace lidar_stereo_fusion

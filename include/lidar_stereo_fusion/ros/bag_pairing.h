@@ -3,7 +3,9 @@
 // checkImageSet, checkCloud), fed in bag order with ROS time = each message's bag (record) time,
 // which is what the node sees under `rosbag play --clock`. Unlike the node it hands on every
 // matched set (the node keeps only the newest for its busy worker) and decides every set still
-// waiting at the end. TF (/tf, /tf_static) goes into a tf2::BufferCore.
+// waiting at the end. TF (/tf, /tf_static) goes into a tf2::BufferCore. Images recorded as
+// sensor_msgs/CompressedImage are decoded as the node decodes them (conversions::decompressImage),
+// and the first sets are checked for a swapped pair (StereoOrderWatch), as the node checks them.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <message_filters/pass_through.h>
 #include <rosbag/message_instance.h>
@@ -18,6 +21,7 @@
 #include <boost/optional.hpp>
 
 #include "lidar_stereo_fusion/ros/node_support.h"
+#include "lidar_stereo_fusion/ros/stereo_order.h"
 #include "lidar_stereo_fusion/ros/stereo_sync.h"
 
 namespace lidar_stereo_fusion {
@@ -56,6 +60,8 @@ class BagPairing {
   std::deque<SetOutcome>& decided() { return decided_; }
   /// Bag time of the last message fed.
   const ros::Time& now() const { return now_; }
+  /// Warnings about the recording as a whole (a swapped stereo pair), each once, to be taken.
+  std::vector<std::string> takeWarnings() { return std::move(warnings_); }
   const tf2::BufferCore& tf() const { return tf_; }
 
  private:
@@ -67,6 +73,10 @@ class BagPairing {
               const sensor_msgs::ImageConstPtr& right, const sensor_msgs::CameraInfoConstPtr& ri);
   void handle(InputMatcher::Events& events);
   void skip(const ros::Time& stamp, const std::string& reason);
+  /// An Image, or a CompressedImage decoded; null (and the problem noted) when it cannot be.
+  sensor_msgs::ImageConstPtr image(const rosbag::MessageInstance& m);
+  /// Why the set at `stamp` is incomplete, when one of its images could not be decoded.
+  std::string imageProblem(const ros::Time& stamp) const;
 
   NodeParams params_;
   BagTopics topics_;
@@ -82,6 +92,9 @@ class BagPairing {
   /// The last sweep refused by checkCloud, so that a set left without one says why.
   ros::Time refused_sweep_stamp_;
   std::string refused_sweep_problem_;
+  std::map<ros::Time, std::string> image_problems_;  ///< images not decoded, by stamp
+  StereoOrderWatch order_watch_;
+  std::vector<std::string> warnings_;
 };
 
 /// "sec.nsec" with 9 digits of nanoseconds: the file name stem of a set's outputs.

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/Header.h>
@@ -55,6 +56,15 @@ std::string checkImage(const sensor_msgs::Image& msg);
 /// for mono8 (always a copy that owns its pixels). Throws ConversionError on an unsupported
 /// encoding or a malformed message.
 cv::Mat imageToCore(const sensor_msgs::ImageConstPtr& msg);
+
+/// Decodes a sensor_msgs/CompressedImage (png or jpeg, as compressed_image_transport and most
+/// recorders write it) into the sensor_msgs/Image the synchroniser and imageToCore take, with the
+/// same header: bgr8 for colour (the codecs' channel order, whatever the format string says the
+/// camera published), bgra8 with an alpha channel, mono8 for grey. Decoded by cv_bridge
+/// (cv_bridge::toCvCopy), so the node and the bag tools decode alike without an image_transport
+/// plugin. Throws ConversionError naming the problem: no data, a compressedDepth image (a depth
+/// map, not a camera image), bytes no codec reads, or a bit depth other than 8.
+sensor_msgs::ImagePtr decompressImage(const sensor_msgs::CompressedImage& msg);
 
 /// Converts a stereo pair; the two results have the same type. A mono8 view with a colour view:
 /// both are matched as grey (the colour one converted with OpenCV's BGR2GRAY), since a grey view

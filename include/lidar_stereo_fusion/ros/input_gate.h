@@ -17,7 +17,6 @@
 #include <string>
 
 #include <image_transport/image_transport.h>
-#include <image_transport/subscriber_filter.h>
 #include <message_filters/subscriber.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -27,8 +26,10 @@
 
 #include "lidar_stereo_fusion/ros/frame_matcher.h"
 #include "lidar_stereo_fusion/ros/fresh_wait.h"
+#include "lidar_stereo_fusion/ros/image_input.h"
 #include "lidar_stereo_fusion/ros/input_watch.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
+#include "lidar_stereo_fusion/ros/stereo_order.h"
 #include "lidar_stereo_fusion/ros/stereo_sync.h"
 
 namespace lidar_stereo_fusion {
@@ -68,8 +69,10 @@ class InputGate {
   /// Incremented whenever ROS time or the stamps restart (a bag loop): a set that arrived in an
   /// earlier epoch cannot measure its latency in ROS time.
   uint32_t clockEpoch() const { return clock_epoch_; }
-  /// The input topics (resolved), comma-separated.
+  /// The input topics (resolved, as subscribed), comma-separated.
   std::string inputTopics() const;
+  /// How the image inputs are subscribed (~image_transport and the installed plugins).
+  const TransportChoice& transport() const { return transport_; }
 
  private:
   using Image = sensor_msgs::Image;
@@ -82,6 +85,8 @@ class InputGate {
                   const sensor_msgs::CameraInfoConstPtr& ri);
   void cloudCb(const sensor_msgs::PointCloud2ConstPtr& cloud);
   void reject(const Rejection& r, const ros::Time& stamp, const char* what_skipped);
+  /// The first image sets: is the pair the right way round (StereoOrderWatch; warns once)?
+  void checkStereoOrder(const ImageSet& set);
   // With mutex_ held:
   void handleEvents(InputMatcher::Events& events, const std::string& topic, const ros::Time& stamp);
   void detectClockJump();
@@ -95,15 +100,16 @@ class InputGate {
   /// Why no sweep matched the image set at `image_stamp` (unmatched, or `waited` for a later one).
   std::string noSweepText(const ros::Time& image_stamp, bool waited) const;
   void waitForFresher(std::unique_lock<std::mutex>& lock);
-  std::string topicName(const std::string& relative) const { return nh_.resolveName(relative); }
+  std::string topicName(const std::string& relative) const;
 
   ros::NodeHandle nh_, pnh_;
   NodeParams params_;
   Counters& counters_;
   ThrottledLog& log_;
+  TransportChoice transport_;  ///< before watch_, which names the topics it chose
 
   std::shared_ptr<image_transport::ImageTransport> it_;
-  image_transport::SubscriberFilter sub_left_image_, sub_right_image_;
+  ImageInput sub_left_image_, sub_right_image_;
   message_filters::Subscriber<Info> sub_left_info_, sub_right_info_;
   std::unique_ptr<StereoSync> sync_;  ///< the image-set synchroniser (shared with bag_runner)
   ros::Subscriber sub_cloud_;
@@ -111,6 +117,8 @@ class InputGate {
   InputWatch watch_;  ///< names silent inputs (its own lock)
   ros::WallTimer watch_timer_;
   std::atomic<bool> watch_clock_started_{false};  ///< under sim time: the watch saw a clock
+  std::mutex order_mutex_;                        ///< order_watch_ (tried, never waited for)
+  StereoOrderWatch order_watch_;
 
   std::mutex mutex_;  ///< the one lock
   std::condition_variable ready_cv_;

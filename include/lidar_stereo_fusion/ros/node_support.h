@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include <ros/node_handle.h>
 #include <ros/time.h>
@@ -23,6 +24,28 @@ constexpr const char* kLeftInfo = "left/camera_info";
 constexpr const char* kRightImage = "right/image_rect_color";
 constexpr const char* kRightInfo = "right/camera_info";
 constexpr const char* kCloud = "velodyne_points";
+
+/// The node's input names (the five above) and output names (relative to its namespace; image
+/// outputs also have image_transport's sub-topics, e.g. depth/image_rect/compressed): what a
+/// remap may name.
+const std::vector<std::string>& inputNames();
+const std::vector<std::string>& outputNames();
+
+/// The name of `names` nearest to `name`: the one name it begins or that begins with it
+/// ("left/image_rect" -> "left/image_rect_color"), else the nearest by edit distance when that
+/// differs in at most a third of its characters ("velodyne_point" -> "velodyne_points"); "" when
+/// none is that near.
+std::string nearestName(const std::string& name, const std::vector<std::string>& names);
+
+/// The remappings (`from` -> `to`, as ROS keeps them: resolved) that name nothing of the node:
+/// a `from` that is none of inputNames() / outputNames() (or an output's image_transport
+/// sub-topic) resolved by `resolve` (the node handle's resolveName without remapping), nor in the
+/// node's private namespace `private_ns`, nor a global name of ROS itself (/tf, /tf_static,
+/// /clock, /rosout, /diagnostics). One text per such remap, naming it, the node's names and the
+/// nearest one: ROS ignores such a remap, so a typo would leave an input at its default.
+std::vector<std::string> unknownRemaps(const std::map<std::string, std::string>& remaps,
+                                       const std::string& node_namespace,
+                                       const std::string& private_ns);
 
 /// A copy of the counters at one moment (FusionStats, diagnostics).
 struct CounterSnapshot {
