@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <stdexcept>
+#include <utility>
 
 #include "lidar_stereo_fusion/core/both_views.h"
 #include "lidar_stereo_fusion/core/motion_compensation.h"
@@ -251,7 +252,9 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
       left = left_prior.input(left_image);
       right = right_prior.input(right_image);
     }
-    result.disparity = patchmatch_.compute(left, right).disparity;
+    PatchMatchResult matched = patchmatch_.compute(left, right);
+    result.disparity = matched.disparity;
+    stats.patchmatch_steps = std::move(matched.steps);
   } else {
     result.disparity = result.prior.clone();
   }

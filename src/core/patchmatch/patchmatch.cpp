@@ -25,7 +25,9 @@
 // the level below checks and fills, and this level up-samples its result (upsampledResult); with
 // unbounded_scale > 1 the pixels without bounds keep the level below's plane (kKeptFromGuide).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
 
@@ -96,6 +98,30 @@ struct PatchMatchStereo::Scratch {
   patchmatch::ViewState left, right;
 };
 
+/// The step timer of one compute(): each lap() names the step that ends there.
+struct PatchMatchStereo::Steps {
+  using Clock = std::chrono::steady_clock;
+  std::vector<PatchMatchStep> list;
+  std::string prefix;
+  Clock::time_point last;
+
+  void start(int level_scale) {
+    list.clear();
+    prefix = "1/" + std::to_string(level_scale) + " ";
+    last = Clock::now();
+  }
+  void lap(const std::string& what) {
+    const Clock::time_point now = Clock::now();
+    list.push_back({prefix + what, std::chrono::duration<double, std::milli>(now - last).count()});
+    last = now;
+  }
+  /// The level below's steps, timed by its own timer.
+  void append(const std::vector<PatchMatchStep>& below) {
+    list.insert(list.end(), below.begin(), below.end());
+    last = Clock::now();
+  }
+};
+
 PatchMatchStereo::PatchMatchStereo(const PatchMatchParams& params) { setParams(params); }
 
 void PatchMatchStereo::setParams(const PatchMatchParams& params) {
@@ -110,12 +136,16 @@ PatchMatchResult PatchMatchStereo::levelBelow(const ViewInput& left, const ViewI
     coarse_->intermediate_ = true;
   }
   coarse_->setParams(patchmatch::coarseParams(p));
+  coarse_->level_scale_ = level_scale_ * p.coarse_scale;
   ViewInput coarse_left, coarse_right;
   bothViews(
       patchmatch::threadCount(p),
       [&] { coarse_left = patchmatch::downsampleView(left, p.coarse_scale); },
       [&] { coarse_right = patchmatch::downsampleView(right, p.coarse_scale); });
-  return coarse_->compute(coarse_left, coarse_right);
+  steps_->lap("reducing the views");
+  PatchMatchResult below = coarse_->compute(coarse_left, coarse_right);
+  steps_->append(below.steps);
+  return below;
 }
 
 PatchMatchResult PatchMatchStereo::upsampledResult(const ViewInput& left, const ViewInput& right) {
@@ -125,6 +155,7 @@ PatchMatchResult PatchMatchStereo::upsampledResult(const ViewInput& left, const 
   const cv::Size size = left.image.size();
   ViewState& lv = scratch_->left;
   preparePrior(left, p, lv);  // the images are the level below's alone
+  steps_->lap("prior and locks");
   const PatchMatchResult below = levelBelow(left, right);
   const int s = p.coarse_scale;
   lv.planes = upsamplePlanes(below.planes, s, size, threads);
@@ -151,6 +182,7 @@ PatchMatchResult PatchMatchStereo::upsampledResult(const ViewInput& left, const 
                   static_cast<float>(p.fill_confidence), result.disparity, threads);
   }
   markEmpty(result.disparity);
+  steps_->lap("up-sampling the result");
   return result;
 }
 
@@ -159,12 +191,21 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   patchmatch::checkViewInput(left, size, "left");
   patchmatch::checkViewInput(right, size, "right");
   if (!scratch_) scratch_ = std::make_shared<Scratch>();
+  if (!steps_) steps_ = std::make_shared<Steps>();
+  steps_->start(level_scale_);
   const bool guided = hasCoarseStart(params_, size);
-  if (guided && params_.search_scale > 1) return upsampledResult(left, right);
-  Level level = prepareLevel(left, right, guided);
-  if (guided) startFromLevelBelow(left, right, level);
-  searchViews(level);
-  return postProcess(level);
+  PatchMatchResult result;
+  if (guided && params_.search_scale > 1) {
+    result = upsampledResult(left, right);
+  } else {
+    Level level = prepareLevel(left, right, guided);
+    steps_->lap("preparing the views");
+    if (guided) startFromLevelBelow(left, right, level);
+    searchViews(level);
+    result = postProcess(level);
+  }
+  result.steps = steps_->list;
+  return result;
 }
 
 PatchMatchStereo::Level PatchMatchStereo::prepareLevel(const ViewInput& left,
@@ -208,6 +249,7 @@ void PatchMatchStereo::startFromLevelBelow(const ViewInput& left, const ViewInpu
     }
   }
   if (p.skip_inconsistent && !below.empty()) skipInconsistent(below, level);
+  steps_->lap("guide and masks");
 }
 
 cv::Mat1b PatchMatchStereo::checkLevelBelow(const PatchMatchResult& coarse,
@@ -250,6 +292,7 @@ void PatchMatchStereo::searchViews(const Level& level) {
   PlaneSearch right_search(p, rv, lv, right_options);
   initialise(left_search, lv, p, 0);
   if (level.right_view) initialise(right_search, rv, p, 1);
+  steps_->lap("initialisation");
   // The right view sweeps in the last `right_iterations` iterations only. It serves view
   // propagation and the left-right check; view propagation runs around its sweeps (left -> right
   // before, right -> left after), since in the other iterations the right view would only hand
@@ -258,6 +301,7 @@ void PatchMatchStereo::searchViews(const Level& level) {
       p.right_iterations < 0 ? level.iterations : std::min(p.right_iterations, level.iterations);
   for (int it = 0; it < level.iterations; ++it) {
     sweep(left_search, lv, p, it);
+    steps_->lap("left sweep");
     if (!level.right_view || it < level.iterations - right_iterations) continue;
     searchRightView(level, left_search, right_search, right_options.refine, it);
   }
@@ -295,12 +339,17 @@ void PatchMatchStereo::searchRightView(const Level& level, const patchmatch::Pla
     } else {
       propagateView(lv, right, rv, p, true);
     }
+    steps_->lap("view propagation to the right");
   }
   sweep(right, rv, p, iteration);
+  steps_->lap("right sweep");
   // A right view swept by propagation alone holds the left planes it was offered or the level
   // below's, which that level's view propagation has handed to the left already: nothing new to
   // hand back (KITTI and Middlebury unchanged without it, a fifth of the level's work).
-  if (p.view_propagation && right_refines) propagateView(rv, left, lv, p, false);
+  if (p.view_propagation && right_refines) {
+    propagateView(rv, left, lv, p, false);
+    steps_->lap("view propagation to the left");
+  }
 }
 
 PatchMatchResult PatchMatchStereo::postProcess(const Level& level) {
@@ -322,6 +371,7 @@ PatchMatchResult PatchMatchStereo::postProcess(const Level& level) {
     result.inconsistent = cv::Mat1b(level.size, uchar(0));
   }
   markEmpty(result.disparity);
+  steps_->lap("check and fill");
   return result;
 }
 
