@@ -126,7 +126,9 @@ PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
   base.right_iterations = -1;
   base.init_from_prior = false;
   base.use_lidar_bounds = false;
-  base.coarse_scale = 1;  // Bleyer: the search runs at full size
+  base.coarse_scale = 1;  // Bleyer: the search runs at full size, every pixel searched
+  base.search_scale = 1;
+  base.unbounded_scale = 1;
   return base;
 }
 
