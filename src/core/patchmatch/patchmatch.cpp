@@ -96,6 +96,7 @@ struct PatchMatchStereo::Level {
 /// frame).
 struct PatchMatchStereo::Scratch {
   patchmatch::ViewState left, right;
+  ViewInput below_left, below_right;  ///< the views reduced for the level below
 };
 
 /// The step timer of one compute(): each lap() names the step that ends there.
@@ -137,11 +138,12 @@ PatchMatchResult PatchMatchStereo::levelBelow(const ViewInput& left, const ViewI
   }
   coarse_->setParams(patchmatch::coarseParams(p));
   coarse_->level_scale_ = level_scale_ * p.coarse_scale;
-  ViewInput coarse_left, coarse_right;
+  ViewInput& coarse_left = scratch_->below_left;
+  ViewInput& coarse_right = scratch_->below_right;
   bothViews(
       patchmatch::threadCount(p),
-      [&] { coarse_left = patchmatch::downsampleView(left, p.coarse_scale); },
-      [&] { coarse_right = patchmatch::downsampleView(right, p.coarse_scale); });
+      [&] { patchmatch::downsampleView(left, p.coarse_scale, coarse_left); },
+      [&] { patchmatch::downsampleView(right, p.coarse_scale, coarse_right); });
   steps_->lap("reducing the views");
   PatchMatchResult below = coarse_->compute(coarse_left, coarse_right);
   steps_->append(below.steps);
@@ -152,36 +154,12 @@ PatchMatchResult PatchMatchStereo::upsampledResult(const ViewInput& left, const 
   using namespace patchmatch;
   const PatchMatchParams& p = params_;
   const int threads = threadCount(p);
-  const cv::Size size = left.image.size();
   ViewState& lv = scratch_->left;
   preparePrior(left, p, lv);  // the images are the level below's alone
   steps_->lap("prior and locks");
   const PatchMatchResult below = levelBelow(left, right);
-  const int s = p.coarse_scale;
-  lv.planes = upsamplePlanes(below.planes, s, size, threads);
-  PatchMatchResult result;
-  result.planes.create(size);
-  result.disparity.create(size);
-  result.inconsistent =
-      p.lr_check ? upsampleMask(below.inconsistent, s, size) : cv::Mat1b(size, uchar(0));
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const int idx = y * size.width + x;
-      Plane& plane = lv.planes[idx];
-      if (lv.locked[idx] == kLockedToPrior) {
-        plane = priorPlane(lv, x, y);
-        result.inconsistent(y, x) = 0;  // the LiDAR measured it: the check keeps it
-      }
-      result.planes(y, x) = cv::Vec3f(plane.a, plane.b, plane.c);
-      result.disparity(y, x) = plane.at(static_cast<float>(x), static_cast<float>(y));
-    }
-  }
-  if (p.lr_check) {
-    fillFromBelow(lv, result.inconsistent.clone(), below.disparity, s,
-                  static_cast<float>(p.fill_confidence), result.disparity, threads);
-  }
-  markEmpty(result.disparity);
+  PatchMatchResult result = resultFromLevelBelow(lv, below, p.coarse_scale, p.lr_check,
+                                                 static_cast<float>(p.fill_confidence), threads);
   steps_->lap("up-sampling the result");
   return result;
 }

@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
 #include "lidar_stereo_fusion/core/patchmatch/median_kernel.h"
 
 namespace lidar_stereo_fusion {
@@ -184,23 +185,48 @@ void weightedMedianFilter(const ViewState& v, const cv::Mat1b& bad, const cv::Ma
 
 }  // namespace
 
-void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, int scale,
-                   float fill_trust, cv::Mat1f& disparity, int threads) {
+namespace {
+
+/// One row of resultFromLevelBelow.
+void resultFromLevelBelowRow(const ViewState& v, const PatchMatchResult& below, int scale,
+                             bool lr_check, float fill_trust, int y, PatchMatchResult& out) {
   const bool has_prior = !v.prior.empty();
   const float s = static_cast<float>(scale);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* below_row = below[std::min(below.rows - 1, y / scale)];
-    for (int x = 0; x < disparity.cols; ++x) {
-      if (!bad(y, x)) continue;
-      if (has_prior && priorFills(v, x, y, fill_trust)) {
-        disparity(y, x) = v.prior(y, x);
-        bad(y, x) = 0;
-      } else {
-        disparity(y, x) = s * below_row[std::min(below.cols - 1, x / scale)];
-      }
-    }
+  const int yb = std::min(below.planes.rows - 1, y / scale);
+  const cv::Vec3f* below_planes = below.planes[yb];
+  const float* below_disparity = below.disparity[yb];
+  const uchar* below_bad = lr_check ? below.inconsistent[yb] : nullptr;
+  cv::Vec3f* planes = out.planes[y];
+  float* disparity = out.disparity[y];
+  uchar* bad = out.inconsistent[y];
+  for (int x = 0; x < v.width; ++x) {
+    const int xb = std::min(below.planes.cols - 1, x / scale);
+    const bool locked = v.locked[y * v.width + x] == kLockedToPrior;
+    const Plane plane = locked ? priorPlane(v, x, y) : upsampledPlane(below_planes[xb], s);
+    planes[x] = cv::Vec3f(plane.a, plane.b, plane.c);
+    float d = plane.at(static_cast<float>(x), static_cast<float>(y));
+    // The LiDAR measured a locked pixel: the check keeps it.
+    bad[x] = !locked && below_bad != nullptr && below_bad[xb] ? 255 : 0;
+    if (bad[x])
+      d = has_prior && priorFills(v, x, y, fill_trust) ? v.prior(y, x) : s * below_disparity[xb];
+    disparity[x] = d > 0.f && std::isfinite(d) ? d : 0.f;  // empty: nothing could fill it
   }
+}
+
+}  // namespace
+
+PatchMatchResult resultFromLevelBelow(const ViewState& v, const PatchMatchResult& below, int scale,
+                                      bool lr_check, float fill_trust, int threads) {
+  const cv::Size size(v.width, v.height);
+  PatchMatchResult out;
+  out.planes.create(size);
+  out.disparity.create(size);
+  out.inconsistent.create(size);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int y = 0; y < size.height; ++y) {
+    resultFromLevelBelowRow(v, below, scale, lr_check, fill_trust, y, out);
+  }
+  return out;
 }
 
 void fillHoles(const ViewState& v, cv::Mat1b bad, const FillOptions& options, cv::Mat1f& disparity,
