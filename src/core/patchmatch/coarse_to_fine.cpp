@@ -6,6 +6,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "lidar_stereo_fusion/core/patchmatch/parallel.h"
+
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
@@ -90,14 +92,15 @@ std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::
   // Coarse pixel i covers full pixels i s .. i s + s - 1: x_c = (x - (s - 1) / 2) / s, so
   // d = s d_c(x_c, y_c) = a x + b y + s c - (a + b) (s - 1) / 2.
   const float s = static_cast<float>(scale);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < full.height; ++y) {
-    const cv::Vec3f* row = coarse[std::min(coarse.rows - 1, y / scale)];
-    for (int x = 0; x < full.width; ++x) {
-      planes[static_cast<size_t>(y) * full.width + x] =
-          upsampledPlane(row[std::min(coarse.cols - 1, x / scale)], s);
+  parallelRows(full.height, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      const cv::Vec3f* row = coarse[std::min(coarse.rows - 1, y / scale)];
+      for (int x = 0; x < full.width; ++x) {
+        planes[static_cast<size_t>(y) * full.width + x] =
+            upsampledPlane(row[std::min(coarse.cols - 1, x / scale)], s);
+      }
     }
-  }
+  });
   return planes;
 }
 

@@ -34,6 +34,7 @@
 #include "lidar_stereo_fusion/core/both_views.h"
 #include "lidar_stereo_fusion/core/patchmatch.h"
 #include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
+#include "lidar_stereo_fusion/core/patchmatch/parallel.h"
 #include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
 #include "lidar_stereo_fusion/core/patchmatch/propagation.h"
 #include "lidar_stereo_fusion/core/patchmatch/view_state.h"
@@ -51,13 +52,14 @@ std::vector<uint8_t> lockedToPrior(const patchmatch::ViewState& v) {
 
 cv::Mat3f planeMap(const patchmatch::ViewState& v, int threads) {
   cv::Mat3f map(v.height, v.width);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < v.height; ++y) {
-    for (int x = 0; x < v.width; ++x) {
-      const patchmatch::Plane& pl = v.planes[y * v.width + x];
-      map(y, x) = cv::Vec3f(pl.a, pl.b, pl.c);
+  patchmatch::parallelRows(v.height, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < v.width; ++x) {
+        const patchmatch::Plane& pl = v.planes[y * v.width + x];
+        map(y, x) = cv::Vec3f(pl.a, pl.b, pl.c);
+      }
     }
-  }
+  });
   return map;
 }
 

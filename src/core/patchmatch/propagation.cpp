@@ -11,6 +11,8 @@
 #include <thread>
 #include <vector>
 
+#include "lidar_stereo_fusion/core/patchmatch/parallel.h"
+
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
@@ -263,15 +265,16 @@ int threadCount(const PatchMatchParams& p) {
 void initialise(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int view) {
   // The cost of an initial plane is computed when the pixel is first visited (currentCost), with
   // the window the visit builds anyway; locked pixels are never compared.
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threadCount(p))
-  for (int y = 0; y < v.height; ++y) {
-    for (int x = 0; x < v.width; ++x) {
-      const int idx = y * v.width + x;
-      Rng rng(streamKey(p.seed, view, -1, idx));
-      v.planes[idx] = search.initialPlane(x, y, rng);
-      v.cost[idx] = kUnknownCost;
+  parallelRows(v.height, threadCount(p), [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < v.width; ++x) {
+        const int idx = y * v.width + x;
+        Rng rng(streamKey(p.seed, view, -1, idx));
+        v.planes[idx] = search.initialPlane(x, y, rng);
+        v.cost[idx] = kUnknownCost;
+      }
     }
-  }
+  });
 }
 
 void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int iteration) {
@@ -298,30 +301,26 @@ void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, i
   // which never wait themselves.
   std::unique_ptr<std::atomic<bool>[]> done(new std::atomic<bool>[strips]);
   for (int i = 0; i < strips; ++i) done[i].store(false, std::memory_order_relaxed);
-  std::atomic<int> next{0};
   const auto ready = [&](int strip) {
     return strip < 0 || strip >= strips || done[strip].load(std::memory_order_acquire);
   };
-#pragma omp parallel num_threads(threads)
-  {
-    WindowCache cache;
-    for (int i = next.fetch_add(1); i < strips; i = next.fetch_add(1)) {
-      const int strip = order[i];
-      if (strip % 2 != first_parity) {
-        while (!ready(strip - 1) || !ready(strip + 1)) std::this_thread::yield();
-      }
-      const int y0 = strip * kStripRows;
-      const int y1 = std::min(v.height, y0 + kStripRows);
-      if (forward) {
-        for (int y = y0; y < y1; ++y)
-          for (int x = 0; x < v.width; ++x) search.processPixel(x, y, true, iteration, cache);
-      } else {
-        for (int y = y1 - 1; y >= y0; --y)
-          for (int x = v.width - 1; x >= 0; --x) search.processPixel(x, y, false, iteration, cache);
-      }
-      done[strip].store(true, std::memory_order_release);
+  parallelFor(strips, threads, [&](int i) {
+    const int strip = order[i];
+    if (strip % 2 != first_parity) {
+      while (!ready(strip - 1) || !ready(strip + 1)) std::this_thread::yield();
     }
-  }
+    WindowCache cache;
+    const int y0 = strip * kStripRows;
+    const int y1 = std::min(v.height, y0 + kStripRows);
+    if (forward) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < v.width; ++x) search.processPixel(x, y, true, iteration, cache);
+    } else {
+      for (int y = y1 - 1; y >= y0; --y)
+        for (int x = v.width - 1; x >= 0; --x) search.processPixel(x, y, false, iteration, cache);
+    }
+    done[strip].store(true, std::memory_order_release);
+  });
 }
 
 }  // namespace patchmatch
