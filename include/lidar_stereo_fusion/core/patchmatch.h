@@ -224,6 +224,7 @@ class PatchMatchStereo {
   std::shared_ptr<PatchMatchStereo> coarse_;  ///< the coarse start's solver (coarse_scale > 1)
   bool intermediate_ = false;                 ///< a reduced level of another solver's coarse start
   int level_scale_ = 1;                       ///< this level's reduction from full size (steps)
+  bool right_planes_wanted_ = true;           ///< PatchMatchResult::right_planes is used
   struct Steps;
   std::shared_ptr<Steps> steps_;  ///< the current compute()'s step timer
 
@@ -232,8 +233,9 @@ class PatchMatchStereo {
   // post-process (left-right check, hole filling, weighted median).
   struct Level;
   Level prepareLevel(const ViewInput& left, const ViewInput& right, bool guided);
-  /// The coarse start's level below, on the views reduced by coarse_scale.
-  PatchMatchResult levelBelow(const ViewInput& left, const ViewInput& right);
+  /// The coarse start's level below, on the views reduced by coarse_scale; its right view's
+  /// planes only if asked (`right_planes`: this level searches a right view from them).
+  PatchMatchResult levelBelow(const ViewInput& left, const ViewInput& right, bool right_planes);
   /// Coarse start: the level below's planes guide this level; its left-right check decides
   /// which pixels are left to the fill (skip_inconsistent) or marked inconsistent here.
   void startFromLevelBelow(const ViewInput& left, const ViewInput& right, Level& level);

@@ -132,7 +132,8 @@ void PatchMatchStereo::setParams(const PatchMatchParams& params) {
   params_ = params;
 }
 
-PatchMatchResult PatchMatchStereo::levelBelow(const ViewInput& left, const ViewInput& right) {
+PatchMatchResult PatchMatchStereo::levelBelow(const ViewInput& left, const ViewInput& right,
+                                              bool right_planes) {
   const PatchMatchParams& p = params_;
   if (!coarse_) {
     coarse_ = std::make_shared<PatchMatchStereo>(patchmatch::coarseParams(p));
@@ -140,6 +141,7 @@ PatchMatchResult PatchMatchStereo::levelBelow(const ViewInput& left, const ViewI
   }
   coarse_->setParams(patchmatch::coarseParams(p));
   coarse_->level_scale_ = level_scale_ * p.coarse_scale;
+  coarse_->right_planes_wanted_ = right_planes;
   ViewInput& coarse_left = scratch_->below_left;
   ViewInput& coarse_right = scratch_->below_right;
   bothViews(
@@ -159,7 +161,7 @@ PatchMatchResult PatchMatchStereo::upsampledResult(const ViewInput& left, const 
   ViewState& lv = scratch_->left;
   preparePrior(left, p, lv);  // the images are the level below's alone
   steps_->lap("prior and locks");
-  const PatchMatchResult below = levelBelow(left, right);
+  const PatchMatchResult below = levelBelow(left, right, false);
   PatchMatchResult result = resultFromLevelBelow(lv, below, p.coarse_scale, p.lr_check,
                                                  static_cast<float>(p.fill_confidence), threads);
   steps_->lap("up-sampling the result");
@@ -212,7 +214,7 @@ void PatchMatchStereo::startFromLevelBelow(const ViewInput& left, const ViewInpu
   using namespace patchmatch;
   const PatchMatchParams& p = params_;
   // Coarse start: its planes, up-sampled, are where this level's search begins.
-  const PatchMatchResult coarse = levelBelow(left, right);
+  const PatchMatchResult coarse = levelBelow(left, right, level.right_view);
   setGuide(upsamplePlanes(coarse.planes, p.coarse_scale, level.size, level.threads), p,
            scratch_->left);
   // The coarse level has no left-right check, so without view propagation it has no right view.
@@ -341,7 +343,7 @@ PatchMatchResult PatchMatchStereo::postProcess(const Level& level) {
   result.planes = planeMap(lv, level.threads);
   if (level.right_view) {
     result.right_disparity = disparityOf(rv, level.threads);
-    result.right_planes = planeMap(rv, level.threads);
+    if (right_planes_wanted_) result.right_planes = planeMap(rv, level.threads);
   }
   if (params_.lr_check) {
     result.inconsistent = consistencyCheck(result, level);

@@ -193,24 +193,29 @@ void PlaneSearch::refine(int x, int y, const WindowCache& cache, Rng& rng, Plane
   }
   float dn = 1.f;
   const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+  // The best plane's normal, computed again only when a candidate replaces it.
+  float best_nx = 0.f, best_ny = 0.f, best_nz = 0.f;
+  bool normal_known = false;
   while (dd >= kMinRefineStep) {
     const float d = best.at(fx, fy) + rng.uniform(-dd, dd);
     Plane candidate{0.f, 0.f, d};
     if (p_.slanted) {
-      float nx, ny, nz;
-      normalOf(best, nx, ny, nz);
-      nx += rng.uniform(-dn, dn);
-      ny += rng.uniform(-dn, dn);
-      nz += rng.uniform(-dn, dn);
+      if (!normal_known) normalOf(best, best_nx, best_ny, best_nz);
+      normal_known = true;
+      const float nx = best_nx + rng.uniform(-dn, dn);
+      const float ny = best_ny + rng.uniform(-dn, dn);
+      const float nz = best_nz + rng.uniform(-dn, dn);
       const float norm = std::sqrt(nx * nx + ny * ny + nz * nz);
       if (norm > 1e-6f && std::abs(nz / norm) >= kMinNormalZ) {
-        candidate = planeFromNormal(fx, fy, d, nx / norm, ny / norm, std::abs(nz) / norm);
-        if (nz < 0.f) candidate = planeFromNormal(fx, fy, d, -nx / norm, -ny / norm, -nz / norm);
+        candidate = nz < 0.f ? planeFromNormal(fx, fy, d, -nx / norm, -ny / norm, -nz / norm)
+                             : planeFromNormal(fx, fy, d, nx / norm, ny / norm, nz / norm);
       } else {
         candidate = Plane{best.a, best.b, d - best.a * fx - best.b * fy};
       }
     }
+    const float before = best_cost;
     tryPlane(x, y, candidate, cache, best, best_cost);
+    if (best_cost != before) normal_known = false;
     dd *= 0.5f;
     dn *= 0.5f;
   }
