@@ -140,7 +140,10 @@ void FusionParams::validate() const {
   patchmatch.validate();
 }
 
-FusionPipeline::FusionPipeline(const FusionParams& params) { setParams(params); }
+FusionPipeline::FusionPipeline(const FusionParams& params) {
+  patchmatch_.setPlanesOutput(false);  // the result is the disparity
+  setParams(params);
+}
 
 void FusionPipeline::setParams(const FusionParams& params) {
   params.validate();

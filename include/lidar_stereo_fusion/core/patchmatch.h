@@ -213,6 +213,10 @@ class PatchMatchStereo {
   explicit PatchMatchStereo(const PatchMatchParams& params = PatchMatchParams());
   void setParams(const PatchMatchParams& params);
   const PatchMatchParams& params() const { return params_; }
+  /// Whether compute() returns the plane maps (PatchMatchResult::planes, right_planes; the
+  /// default): without them, a frame maps and allocates two full-size images less (the fusion
+  /// pipeline reads the disparity alone).
+  void setPlanesOutput(bool planes);
 
   /// left/right images must have the same size and type. Priors and bounds are optional.
   PatchMatchResult compute(const ViewInput& left, const ViewInput& right);
@@ -224,6 +228,7 @@ class PatchMatchStereo {
   std::shared_ptr<PatchMatchStereo> coarse_;  ///< the coarse start's solver (coarse_scale > 1)
   bool intermediate_ = false;                 ///< a reduced level of another solver's coarse start
   int level_scale_ = 1;                       ///< this level's reduction from full size (steps)
+  bool planes_wanted_ = true;                 ///< PatchMatchResult::planes is used
   bool right_planes_wanted_ = true;           ///< PatchMatchResult::right_planes is used
   struct Steps;
   std::shared_ptr<Steps> steps_;  ///< the current compute()'s step timer

@@ -127,6 +127,8 @@ struct PatchMatchStereo::Steps {
 
 PatchMatchStereo::PatchMatchStereo(const PatchMatchParams& params) { setParams(params); }
 
+void PatchMatchStereo::setPlanesOutput(bool planes) { planes_wanted_ = planes; }
+
 void PatchMatchStereo::setParams(const PatchMatchParams& params) {
   params.validate();
   params_ = params;
@@ -162,8 +164,9 @@ PatchMatchResult PatchMatchStereo::upsampledResult(const ViewInput& left, const 
   preparePrior(left, p, lv);  // the images are the level below's alone
   steps_->lap("prior and locks");
   const PatchMatchResult below = levelBelow(left, right, false);
-  PatchMatchResult result = resultFromLevelBelow(lv, below, p.coarse_scale, p.lr_check,
-                                                 static_cast<float>(p.fill_confidence), threads);
+  PatchMatchResult result =
+      resultFromLevelBelow(lv, below, p.coarse_scale, p.lr_check,
+                           static_cast<float>(p.fill_confidence), planes_wanted_, threads);
   steps_->lap("up-sampling the result");
   return result;
 }
@@ -342,10 +345,10 @@ PatchMatchResult PatchMatchStereo::postProcess(const Level& level) {
   const ViewState& rv = scratch_->right;
   PatchMatchResult result;
   result.disparity = disparityOf(lv, level.threads);
-  result.planes = planeMap(lv, level.threads);
+  if (planes_wanted_) result.planes = planeMap(lv, level.threads);
   if (level.right_view) {
     result.right_disparity = disparityOf(rv, level.threads);
-    if (right_planes_wanted_) result.right_planes = planeMap(rv, level.threads);
+    if (planes_wanted_ && right_planes_wanted_) result.right_planes = planeMap(rv, level.threads);
   }
   if (params_.lr_check) {
     result.inconsistent = consistencyCheck(result, level);

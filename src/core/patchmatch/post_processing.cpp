@@ -193,20 +193,21 @@ namespace {
 /// One row of resultFromLevelBelow.
 void resultFromLevelBelowRow(const ViewState& v, const PatchMatchResult& below, int scale,
                              bool lr_check, float fill_trust, int y, PatchMatchResult& out) {
+  const bool with_planes = !out.planes.empty();
   const bool has_prior = !v.prior.empty();
   const float s = static_cast<float>(scale);
   const int yb = std::min(below.planes.rows - 1, y / scale);
   const cv::Vec3f* below_planes = below.planes[yb];
   const float* below_disparity = below.disparity[yb];
   const uchar* below_bad = lr_check ? below.inconsistent[yb] : nullptr;
-  cv::Vec3f* planes = out.planes[y];
+  cv::Vec3f* planes = with_planes ? out.planes[y] : nullptr;
   float* disparity = out.disparity[y];
   uchar* bad = out.inconsistent[y];
   for (int x = 0; x < v.width; ++x) {
     const int xb = std::min(below.planes.cols - 1, x / scale);
     const bool locked = v.locked[y * v.width + x] == kLockedToPrior;
     const Plane plane = locked ? priorPlane(v, x, y) : upsampledPlane(below_planes[xb], s);
-    planes[x] = cv::Vec3f(plane.a, plane.b, plane.c);
+    if (with_planes) planes[x] = cv::Vec3f(plane.a, plane.b, plane.c);
     float d = plane.at(static_cast<float>(x), static_cast<float>(y));
     // The LiDAR measured a locked pixel: the check keeps it.
     bad[x] = !locked && below_bad != nullptr && below_bad[xb] ? 255 : 0;
@@ -219,10 +220,10 @@ void resultFromLevelBelowRow(const ViewState& v, const PatchMatchResult& below, 
 }  // namespace
 
 PatchMatchResult resultFromLevelBelow(const ViewState& v, const PatchMatchResult& below, int scale,
-                                      bool lr_check, float fill_trust, int threads) {
+                                      bool lr_check, float fill_trust, bool planes, int threads) {
   const cv::Size size(v.width, v.height);
   PatchMatchResult out;
-  out.planes.create(size);
+  if (planes) out.planes.create(size);
   out.disparity.create(size);
   out.inconsistent.create(size);
   parallelRows(size.height, threads, [&](int y0, int y1) {

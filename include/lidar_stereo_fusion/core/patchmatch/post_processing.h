@@ -30,9 +30,11 @@ cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float ma
 /// plane's; with `lr_check`, the pixels the level below's check marks (not those locked) are
 /// marked in `inconsistent` and filled: by the prior where it has a value and its trust is >=
 /// fill_trust (as fillHoles), else by `scale` times the level below's filled disparity at (x /
-/// scale, y / scale). Non-positive or non-finite disparities become 0 (empty).
+/// scale, y / scale). Non-positive or non-finite disparities become 0 (empty). The plane map
+/// only with `planes`.
 PatchMatchResult resultFromLevelBelow(const ViewState& v, const PatchMatchResult& below, int scale,
-                                      bool lr_check, float fill_trust, int threads = 1);
+                                      bool lr_check, float fill_trust, bool planes = true,
+                                      int threads = 1);
 
 /// How fillHoles fills (PatchMatchParams' median_radius, weight_delta, fill_confidence,
 /// max_disparity and simd_path).
