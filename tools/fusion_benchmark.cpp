@@ -175,6 +175,11 @@ void printStages(const Timing& t) {
   printRow("up-sampling + confidence (both views)",
            medianOf(t.stats, &lsf::FrameStats::upsampling_ms));
   printRow("PatchMatch", medianOf(t.stats, &lsf::FrameStats::patchmatch_ms));
+  for (size_t i = 0; i < t.stats.front().patchmatch_steps.size(); ++i) {  // the same every run
+    std::vector<double> ms;
+    for (const auto& s : t.stats) ms.push_back(s.patchmatch_steps[i].ms);
+    printRow(("  " + t.stats.front().patchmatch_steps[i].name).c_str(), lsf::median(ms));
+  }
   printRow("depth", medianOf(t.stats, &lsf::FrameStats::depth_ms));
   printRow("total per frame (pipeline)", medianOf(t.stats, &lsf::FrameStats::total_ms));
   if (!t.sgbm_ms.empty()) {

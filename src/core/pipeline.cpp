@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <stdexcept>
+#include <utility>
 
 #include "lidar_stereo_fusion/core/both_views.h"
 #include "lidar_stereo_fusion/core/motion_compensation.h"
@@ -125,8 +126,9 @@ PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
   base.right_iterations = -1;
   base.init_from_prior = false;
   base.use_lidar_bounds = false;
-  base.coarse_scale = 1;  // Bleyer: the search runs at full size
-  base.search_scale = 1;  // and searches there (a preset's coarse-only search has no level here)
+  base.coarse_scale = 1;  // Bleyer: the search runs at full size, every pixel searched
+  base.search_scale = 1;  // (a preset's coarse-only search has no level here)
+  base.unbounded_scale = 1;
   return base;
 }
 
@@ -138,7 +140,10 @@ void FusionParams::validate() const {
   patchmatch.validate();
 }
 
-FusionPipeline::FusionPipeline(const FusionParams& params) { setParams(params); }
+FusionPipeline::FusionPipeline(const FusionParams& params) {
+  patchmatch_.setPlanesOutput(false);  // the result is the disparity
+  setParams(params);
+}
 
 void FusionPipeline::setParams(const FusionParams& params) {
   params.validate();
@@ -252,7 +257,9 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
       left = left_prior.input(left_image);
       right = right_prior.input(right_image);
     }
-    result.disparity = patchmatch_.compute(left, right).disparity;
+    PatchMatchResult matched = patchmatch_.compute(left, right);
+    result.disparity = matched.disparity;
+    stats.patchmatch_steps = std::move(matched.steps);
   } else {
     result.disparity = result.prior.clone();
   }

@@ -172,6 +172,26 @@ TEST(PatchMatchCoarseStart, AtSearchScale2FullSizeUpsamplesTheCheckedAndFilledHa
   EXPECT_GT(filled, 0);  // the right border, hidden in the right view
 }
 
+TEST(PatchMatchCoarseStart, WithoutPlaneMapsTheDisparityAndTheCheckAreTheSame) {
+  // The fusion pipeline reads the disparity alone (setPlanesOutput(false)): the search, levels
+  // below included, is the same, only the plane maps are not returned.
+  const lsf::test::PlaneScene s = lsf::test::PlaneScene::make(96, 48, 0.05, 0.0, 6.0, 4);
+  for (const int search_scale : {1, 2}) {
+    lsf::PatchMatchParams p;
+    p.max_disparity = 16;
+    p.search_scale = search_scale;
+    lsf::PatchMatchStereo with(p), without(p);
+    without.setPlanesOutput(false);
+    const lsf::PatchMatchResult a = with.compute({s.left}, {s.right});
+    const lsf::PatchMatchResult b = without.compute({s.left}, {s.right});
+    EXPECT_FALSE(a.planes.empty());
+    EXPECT_TRUE(b.planes.empty());
+    EXPECT_TRUE(b.right_planes.empty());
+    EXPECT_EQ(cv::norm(a.disparity, b.disparity, cv::NORM_INF), 0.0) << search_scale;
+    EXPECT_EQ(cv::norm(a.inconsistent, b.inconsistent, cv::NORM_INF), 0.0) << search_scale;
+  }
+}
+
 TEST(PatchMatchCoarseStart, InconsistentPixelsWithoutBoundsAreLeftToTheFill) {
   const lsf::PatchMatchParams p = params3x3();
   Views v = guided6x4(p);

@@ -291,6 +291,19 @@ TEST(ParamsYaml, TheLivePresetCutsTheSearchOnly) {
   expectSame(p, expected);
 }
 
+// accuracy_report's pms rows take the --params file as their base: plain PMS searches every
+// pixel at full size, whatever the preset's levels (search_scale 2 once failed its validation).
+TEST(ParamsYaml, PlainPmsOnTheLivePresetSearchesAtFullSize) {
+  FusionParams p;
+  loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/live.yaml", p);
+  const PatchMatchParams pms = FusionParams::plainPmsParams(p.patchmatch);
+  EXPECT_EQ(pms.coarse_scale, 1);
+  EXPECT_EQ(pms.search_scale, 1);
+  EXPECT_EQ(pms.unbounded_scale, 1);
+  p.method = Method::kPlainPMS;
+  EXPECT_NO_THROW(FusionPipeline{p});
+}
+
 TEST(ParamsYaml, OpenCvStyleFileWithDirectiveAndEmptyFileAreAccepted) {
   YamlFile with_directive("%YAML:1.0\n---\nbi:\n  max_gap_px: 5\n  search_lines: 1\n");
   FusionParams p;

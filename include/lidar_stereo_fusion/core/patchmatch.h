@@ -5,7 +5,9 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -169,6 +171,13 @@ struct PatchMatchParams {
 static_assert(PatchMatchParams::kMaxWindowRadius == patchmatch::kMaxWindowRadius,
               "window_radius's range and the kernels' buffers must agree");
 
+/// Wall time of one step of PatchMatchStereo::compute, named by its level ("1/4", "1/2", "1/1")
+/// and what it does (e.g. "1/2 left sweep"): the per-stage table of fusion_benchmark.
+struct PatchMatchStep {
+  std::string name;
+  double ms = 0;
+};
+
 /// Output of PatchMatch for the left view.
 struct PatchMatchResult {
   cv::Mat1f disparity;        ///< dense left disparity [px], 0 where nothing could be filled
@@ -176,6 +185,7 @@ struct PatchMatchResult {
   cv::Mat1b inconsistent;     ///< 255 where the left-right check failed (then filled)
   cv::Mat3f planes;           ///< per-pixel plane (a, b, c): d = a x + b y + c
   cv::Mat3f right_planes;     ///< the same for the right view (when computed)
+  std::vector<PatchMatchStep> steps;  ///< the steps' wall times, coarsest level first
 };
 
 /// Inputs of one view.
@@ -203,6 +213,10 @@ class PatchMatchStereo {
   explicit PatchMatchStereo(const PatchMatchParams& params = PatchMatchParams());
   void setParams(const PatchMatchParams& params);
   const PatchMatchParams& params() const { return params_; }
+  /// Whether compute() returns the plane maps (PatchMatchResult::planes, right_planes; the
+  /// default): without them, a frame maps and allocates two full-size images less (the fusion
+  /// pipeline reads the disparity alone).
+  void setPlanesOutput(bool planes);
 
   /// left/right images must have the same size and type. Priors and bounds are optional.
   PatchMatchResult compute(const ViewInput& left, const ViewInput& right);
@@ -213,14 +227,20 @@ class PatchMatchStereo {
   std::shared_ptr<Scratch> scratch_;
   std::shared_ptr<PatchMatchStereo> coarse_;  ///< the coarse start's solver (coarse_scale > 1)
   bool intermediate_ = false;                 ///< a reduced level of another solver's coarse start
+  int level_scale_ = 1;                       ///< this level's reduction from full size (steps)
+  bool planes_wanted_ = true;                 ///< PatchMatchResult::planes is used
+  bool right_planes_wanted_ = true;           ///< PatchMatchResult::right_planes is used
+  struct Steps;
+  std::shared_ptr<Steps> steps_;  ///< the current compute()'s step timer
 
   // compute()'s stages, in order (patchmatch.cpp): prepare the views, start from the coarse
   // start's planes, search each view (initialisation, propagation, refinement, view propagation),
   // post-process (left-right check, hole filling, weighted median).
   struct Level;
   Level prepareLevel(const ViewInput& left, const ViewInput& right, bool guided);
-  /// The coarse start's level below, on the views reduced by coarse_scale.
-  PatchMatchResult levelBelow(const ViewInput& left, const ViewInput& right);
+  /// The coarse start's level below, on the views reduced by coarse_scale; its right view's
+  /// planes only if asked (`right_planes`: this level searches a right view from them).
+  PatchMatchResult levelBelow(const ViewInput& left, const ViewInput& right, bool right_planes);
   /// Coarse start: the level below's planes guide this level; its left-right check decides
   /// which pixels are left to the fill (skip_inconsistent) or marked inconsistent here.
   void startFromLevelBelow(const ViewInput& left, const ViewInput& right, Level& level);

@@ -47,6 +47,7 @@ struct FrameStats {
   int points_removed = 0;      ///< scan-line pixels removed by Algorithm 1 (left view)
   double prior_coverage = 0;   ///< fraction of pixels with an up-sampled prior
   double output_coverage = 0;  ///< fraction of pixels with an output disparity
+  std::vector<PatchMatchStep> patchmatch_steps;  ///< PatchMatch's steps (PatchMatchResult::steps)
 };
 
 struct FusionResult {

@@ -6,6 +6,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "lidar_stereo_fusion/core/patchmatch/parallel.h"
+
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
@@ -16,31 +18,47 @@ cv::Size coarseSize(const cv::Size& full, int scale) {
                   std::max(1, (full.height + scale - 1) / scale));
 }
 
-/// Nearest-neighbour reduction of a float map, values multiplied by `factor`.
-cv::Mat1f reduceMap(const cv::Mat1f& map, const cv::Size& size, int scale, float factor) {
-  if (map.empty()) return cv::Mat1f();
-  cv::Mat1f out(size);
-  for (int y = 0; y < size.height; ++y) {
-    const float* src = map[std::min(map.rows - 1, y * scale + scale / 2)];
-    float* dst = out[y];
-    for (int x = 0; x < size.width; ++x)
-      dst[x] = src[std::min(map.cols - 1, x * scale + scale / 2)] * factor;
+/// Nearest-neighbour reduction of a float map into `out` (its buffer reused when it has the size;
+/// released when `map` is empty), values multiplied by `factor`: pixel (x, y) takes (x scale +
+/// scale / 2, y scale + scale / 2), clamped to the map.
+void reduceMap(const cv::Mat1f& map, const cv::Size& size, int scale, float factor,
+               cv::Mat1f& out) {
+  if (map.empty()) {
+    out.release();
+    return;
   }
-  return out;
+  out.create(size);
+  const int half = scale / 2;
+  // The columns whose source lies inside the map; the others (at most one) take its last column.
+  const int inside = map.cols > half ? std::min(size.width, (map.cols - 1 - half) / scale + 1) : 0;
+  for (int y = 0; y < size.height; ++y) {
+    const float* src = map[std::min(map.rows - 1, y * scale + half)];
+    float* dst = out[y];
+    if (scale == 2) {  // the usual reduction, in a loop the compiler vectorises
+      for (int x = 0; x < inside; ++x) dst[x] = src[2 * x + 1] * factor;
+    } else {
+      for (int x = 0; x < inside; ++x) dst[x] = src[x * scale + half] * factor;
+    }
+    for (int x = inside; x < size.width; ++x) dst[x] = src[map.cols - 1] * factor;
+  }
 }
 
 }  // namespace
 
-ViewInput downsampleView(const ViewInput& in, int scale) {
+void downsampleView(const ViewInput& in, int scale, ViewInput& out) {
   const cv::Size size = coarseSize(in.image.size(), scale);
-  ViewInput out;
   cv::resize(in.image, out.image, size, 0, 0, cv::INTER_AREA);
   const float inv = 1.f / static_cast<float>(scale);
-  out.prior = reduceMap(in.prior, size, scale, inv);
-  out.confidence = reduceMap(in.confidence, size, scale, 1.f);
-  out.bounds.lo = reduceMap(in.bounds.lo, size, scale, inv);
-  out.bounds.hi = reduceMap(in.bounds.hi, size, scale, inv);
-  out.bounds.range = reduceMap(in.bounds.range, size, scale, inv);
+  reduceMap(in.prior, size, scale, inv, out.prior);
+  reduceMap(in.confidence, size, scale, 1.f, out.confidence);
+  reduceMap(in.bounds.lo, size, scale, inv, out.bounds.lo);
+  reduceMap(in.bounds.hi, size, scale, inv, out.bounds.hi);
+  reduceMap(in.bounds.range, size, scale, inv, out.bounds.range);
+}
+
+ViewInput downsampleView(const ViewInput& in, int scale) {
+  ViewInput out;
+  downsampleView(in, scale, out);
   return out;
 }
 
@@ -71,19 +89,18 @@ PatchMatchParams coarseParams(const PatchMatchParams& p) {
 std::vector<Plane> upsamplePlanes(const cv::Mat3f& coarse, int scale, const cv::Size& full,
                                   int threads) {
   std::vector<Plane> planes(static_cast<size_t>(full.area()));
-  const float s = static_cast<float>(scale);
   // Coarse pixel i covers full pixels i s .. i s + s - 1: x_c = (x - (s - 1) / 2) / s, so
   // d = s d_c(x_c, y_c) = a x + b y + s c - (a + b) (s - 1) / 2.
-  const float offset = 0.5f * (s - 1.f);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < full.height; ++y) {
-    const cv::Vec3f* row = coarse[std::min(coarse.rows - 1, y / scale)];
-    for (int x = 0; x < full.width; ++x) {
-      const cv::Vec3f& q = row[std::min(coarse.cols - 1, x / scale)];
-      planes[static_cast<size_t>(y) * full.width + x] =
-          Plane{q[0], q[1], s * q[2] - offset * (q[0] + q[1])};
+  const float s = static_cast<float>(scale);
+  parallelRows(full.height, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      const cv::Vec3f* row = coarse[std::min(coarse.rows - 1, y / scale)];
+      for (int x = 0; x < full.width; ++x) {
+        planes[static_cast<size_t>(y) * full.width + x] =
+            upsampledPlane(row[std::min(coarse.cols - 1, x / scale)], s);
+      }
     }
-  }
+  });
   return planes;
 }
 

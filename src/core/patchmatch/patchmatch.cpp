@@ -25,13 +25,16 @@
 // the level below checks and fills, and this level up-samples its result (upsampledResult); with
 // unbounded_scale > 1 the pixels without bounds keep the level below's plane (kKeptFromGuide).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
 
 #include "lidar_stereo_fusion/core/both_views.h"
 #include "lidar_stereo_fusion/core/patchmatch.h"
 #include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
+#include "lidar_stereo_fusion/core/patchmatch/parallel.h"
 #include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
 #include "lidar_stereo_fusion/core/patchmatch/propagation.h"
 #include "lidar_stereo_fusion/core/patchmatch/view_state.h"
@@ -49,13 +52,14 @@ std::vector<uint8_t> lockedToPrior(const patchmatch::ViewState& v) {
 
 cv::Mat3f planeMap(const patchmatch::ViewState& v, int threads) {
   cv::Mat3f map(v.height, v.width);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < v.height; ++y) {
-    for (int x = 0; x < v.width; ++x) {
-      const patchmatch::Plane& pl = v.planes[y * v.width + x];
-      map(y, x) = cv::Vec3f(pl.a, pl.b, pl.c);
+  patchmatch::parallelRows(v.height, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < v.width; ++x) {
+        const patchmatch::Plane& pl = v.planes[y * v.width + x];
+        map(y, x) = cv::Vec3f(pl.a, pl.b, pl.c);
+      }
     }
-  }
+  });
   return map;
 }
 
@@ -94,63 +98,76 @@ struct PatchMatchStereo::Level {
 /// frame).
 struct PatchMatchStereo::Scratch {
   patchmatch::ViewState left, right;
+  ViewInput below_left, below_right;  ///< the views reduced for the level below
+};
+
+/// The step timer of one compute(): each lap() names the step that ends there.
+struct PatchMatchStereo::Steps {
+  using Clock = std::chrono::steady_clock;
+  std::vector<PatchMatchStep> list;
+  std::string prefix;
+  Clock::time_point last;
+
+  void start(int level_scale) {
+    list.clear();
+    prefix = "1/" + std::to_string(level_scale) + " ";
+    last = Clock::now();
+  }
+  void lap(const std::string& what) {
+    const Clock::time_point now = Clock::now();
+    list.push_back({prefix + what, std::chrono::duration<double, std::milli>(now - last).count()});
+    last = now;
+  }
+  /// The level below's steps, timed by its own timer.
+  void append(const std::vector<PatchMatchStep>& below) {
+    list.insert(list.end(), below.begin(), below.end());
+    last = Clock::now();
+  }
 };
 
 PatchMatchStereo::PatchMatchStereo(const PatchMatchParams& params) { setParams(params); }
+
+void PatchMatchStereo::setPlanesOutput(bool planes) { planes_wanted_ = planes; }
 
 void PatchMatchStereo::setParams(const PatchMatchParams& params) {
   params.validate();
   params_ = params;
 }
 
-PatchMatchResult PatchMatchStereo::levelBelow(const ViewInput& left, const ViewInput& right) {
+PatchMatchResult PatchMatchStereo::levelBelow(const ViewInput& left, const ViewInput& right,
+                                              bool right_planes) {
   const PatchMatchParams& p = params_;
   if (!coarse_) {
     coarse_ = std::make_shared<PatchMatchStereo>(patchmatch::coarseParams(p));
     coarse_->intermediate_ = true;
   }
   coarse_->setParams(patchmatch::coarseParams(p));
-  ViewInput coarse_left, coarse_right;
+  coarse_->level_scale_ = level_scale_ * p.coarse_scale;
+  coarse_->right_planes_wanted_ = right_planes;
+  ViewInput& coarse_left = scratch_->below_left;
+  ViewInput& coarse_right = scratch_->below_right;
   bothViews(
       patchmatch::threadCount(p),
-      [&] { coarse_left = patchmatch::downsampleView(left, p.coarse_scale); },
-      [&] { coarse_right = patchmatch::downsampleView(right, p.coarse_scale); });
-  return coarse_->compute(coarse_left, coarse_right);
+      [&] { patchmatch::downsampleView(left, p.coarse_scale, coarse_left); },
+      [&] { patchmatch::downsampleView(right, p.coarse_scale, coarse_right); });
+  steps_->lap("reducing the views");
+  PatchMatchResult below = coarse_->compute(coarse_left, coarse_right);
+  steps_->append(below.steps);
+  return below;
 }
 
 PatchMatchResult PatchMatchStereo::upsampledResult(const ViewInput& left, const ViewInput& right) {
   using namespace patchmatch;
   const PatchMatchParams& p = params_;
   const int threads = threadCount(p);
-  const cv::Size size = left.image.size();
   ViewState& lv = scratch_->left;
   preparePrior(left, p, lv);  // the images are the level below's alone
-  const PatchMatchResult below = levelBelow(left, right);
-  const int s = p.coarse_scale;
-  lv.planes = upsamplePlanes(below.planes, s, size, threads);
-  PatchMatchResult result;
-  result.planes.create(size);
-  result.disparity.create(size);
-  result.inconsistent =
-      p.lr_check ? upsampleMask(below.inconsistent, s, size) : cv::Mat1b(size, uchar(0));
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const int idx = y * size.width + x;
-      Plane& plane = lv.planes[idx];
-      if (lv.locked[idx] == kLockedToPrior) {
-        plane = priorPlane(lv, x, y);
-        result.inconsistent(y, x) = 0;  // the LiDAR measured it: the check keeps it
-      }
-      result.planes(y, x) = cv::Vec3f(plane.a, plane.b, plane.c);
-      result.disparity(y, x) = plane.at(static_cast<float>(x), static_cast<float>(y));
-    }
-  }
-  if (p.lr_check) {
-    fillFromBelow(lv, result.inconsistent.clone(), below.disparity, s,
-                  static_cast<float>(p.fill_confidence), result.disparity, threads);
-  }
-  markEmpty(result.disparity);
+  steps_->lap("prior and locks");
+  const PatchMatchResult below = levelBelow(left, right, false);
+  PatchMatchResult result =
+      resultFromLevelBelow(lv, below, p.coarse_scale, p.lr_check,
+                           static_cast<float>(p.fill_confidence), planes_wanted_, threads);
+  steps_->lap("up-sampling the result");
   return result;
 }
 
@@ -159,12 +176,21 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   patchmatch::checkViewInput(left, size, "left");
   patchmatch::checkViewInput(right, size, "right");
   if (!scratch_) scratch_ = std::make_shared<Scratch>();
+  if (!steps_) steps_ = std::make_shared<Steps>();
+  steps_->start(level_scale_);
   const bool guided = hasCoarseStart(params_, size);
-  if (guided && params_.search_scale > 1) return upsampledResult(left, right);
-  Level level = prepareLevel(left, right, guided);
-  if (guided) startFromLevelBelow(left, right, level);
-  searchViews(level);
-  return postProcess(level);
+  PatchMatchResult result;
+  if (guided && params_.search_scale > 1) {
+    result = upsampledResult(left, right);
+  } else {
+    Level level = prepareLevel(left, right, guided);
+    steps_->lap("preparing the views");
+    if (guided) startFromLevelBelow(left, right, level);
+    searchViews(level);
+    result = postProcess(level);
+  }
+  result.steps = steps_->list;
+  return result;
 }
 
 PatchMatchStereo::Level PatchMatchStereo::prepareLevel(const ViewInput& left,
@@ -191,7 +217,7 @@ void PatchMatchStereo::startFromLevelBelow(const ViewInput& left, const ViewInpu
   using namespace patchmatch;
   const PatchMatchParams& p = params_;
   // Coarse start: its planes, up-sampled, are where this level's search begins.
-  const PatchMatchResult coarse = levelBelow(left, right);
+  const PatchMatchResult coarse = levelBelow(left, right, level.right_view);
   setGuide(upsamplePlanes(coarse.planes, p.coarse_scale, level.size, level.threads), p,
            scratch_->left);
   // The coarse level has no left-right check, so without view propagation it has no right view.
@@ -208,6 +234,7 @@ void PatchMatchStereo::startFromLevelBelow(const ViewInput& left, const ViewInpu
     }
   }
   if (p.skip_inconsistent && !below.empty()) skipInconsistent(below, level);
+  steps_->lap("guide and masks");
 }
 
 cv::Mat1b PatchMatchStereo::checkLevelBelow(const PatchMatchResult& coarse,
@@ -250,6 +277,7 @@ void PatchMatchStereo::searchViews(const Level& level) {
   PlaneSearch right_search(p, rv, lv, right_options);
   initialise(left_search, lv, p, 0);
   if (level.right_view) initialise(right_search, rv, p, 1);
+  steps_->lap("initialisation");
   // The right view sweeps in the last `right_iterations` iterations only. It serves view
   // propagation and the left-right check; view propagation runs around its sweeps (left -> right
   // before, right -> left after), since in the other iterations the right view would only hand
@@ -258,6 +286,7 @@ void PatchMatchStereo::searchViews(const Level& level) {
       p.right_iterations < 0 ? level.iterations : std::min(p.right_iterations, level.iterations);
   for (int it = 0; it < level.iterations; ++it) {
     sweep(left_search, lv, p, it);
+    steps_->lap("left sweep");
     if (!level.right_view || it < level.iterations - right_iterations) continue;
     searchRightView(level, left_search, right_search, right_options.refine, it);
   }
@@ -287,20 +316,27 @@ void PatchMatchStereo::searchRightView(const Level& level, const patchmatch::Pla
   ViewState& lv = scratch_->left;
   ViewState& rv = scratch_->right;
   if (p.view_propagation) {
-    // After a coarse start, the right view tries the left planes in its sweep, with the windows
-    // the sweep builds anyway; Bleyer's view propagation (the coarsest level, the paper preset,
-    // plain PMS) builds one more per pixel, before the sweep.
-    if (level.guided) {
+    // In a coarse start (every level of it, the coarsest too), the right view tries the left
+    // planes in its sweep, with the windows the sweep builds anyway; Bleyer's view propagation
+    // (a search without coarse start: the paper preset, plain PMS) builds one more per pixel,
+    // before the sweep. (At the coarsest level the offers took 1.8 of its 32 ms on one thread,
+    // every protocol within its seed noise.)
+    if (level.guided || intermediate_) {
       offerView(lv, right, rv, p, true);
     } else {
       propagateView(lv, right, rv, p, true);
     }
+    steps_->lap("view propagation to the right");
   }
   sweep(right, rv, p, iteration);
+  steps_->lap("right sweep");
   // A right view swept by propagation alone holds the left planes it was offered or the level
   // below's, which that level's view propagation has handed to the left already: nothing new to
   // hand back (KITTI and Middlebury unchanged without it, a fifth of the level's work).
-  if (p.view_propagation && right_refines) propagateView(rv, left, lv, p, false);
+  if (p.view_propagation && right_refines) {
+    propagateView(rv, left, lv, p, false);
+    steps_->lap("view propagation to the left");
+  }
 }
 
 PatchMatchResult PatchMatchStereo::postProcess(const Level& level) {
@@ -309,10 +345,10 @@ PatchMatchResult PatchMatchStereo::postProcess(const Level& level) {
   const ViewState& rv = scratch_->right;
   PatchMatchResult result;
   result.disparity = disparityOf(lv, level.threads);
-  result.planes = planeMap(lv, level.threads);
+  if (planes_wanted_) result.planes = planeMap(lv, level.threads);
   if (level.right_view) {
     result.right_disparity = disparityOf(rv, level.threads);
-    result.right_planes = planeMap(rv, level.threads);
+    if (planes_wanted_ && right_planes_wanted_) result.right_planes = planeMap(rv, level.threads);
   }
   if (params_.lr_check) {
     result.inconsistent = consistencyCheck(result, level);
@@ -322,6 +358,7 @@ PatchMatchResult PatchMatchStereo::postProcess(const Level& level) {
     result.inconsistent = cv::Mat1b(level.size, uchar(0));
   }
   markEmpty(result.disparity);
+  steps_->lap("check and fill");
   return result;
 }
 

@@ -1,14 +1,14 @@
 // PatchMatch post-processing: left-right check and hole filling (post_processing.h).
 #include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
+#include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
 #include "lidar_stereo_fusion/core/patchmatch/median_kernel.h"
+#include "lidar_stereo_fusion/core/patchmatch/parallel.h"
 
 namespace lidar_stereo_fusion {
 namespace patchmatch {
@@ -49,31 +49,33 @@ float weightedMedian(float* d, float* w, int n, float half, SimdPath path) {
 
 cv::Mat1f disparityOf(const ViewState& v, int threads) {
   cv::Mat1f d(v.height, v.width);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < v.height; ++y) {
-    for (int x = 0; x < v.width; ++x) {
-      d(y, x) = v.planes[y * v.width + x].at(static_cast<float>(x), static_cast<float>(y));
+  parallelRows(v.height, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < v.width; ++x) {
+        d(y, x) = v.planes[y * v.width + x].at(static_cast<float>(x), static_cast<float>(y));
+      }
     }
-  }
+  });
   return d;
 }
 
 cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float max_diff,
                          const std::vector<uint8_t>& keep, bool unmatched_bad, int threads) {
   cv::Mat1b bad(left.size(), uchar(0));
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < left.rows; ++y) {
-    for (int x = 0; x < left.cols; ++x) {
-      if (!keep.empty() && keep[y * left.cols + x]) continue;
-      const float d = left(y, x);
-      const int xr = static_cast<int>(std::lround(x - d));
-      if (xr < 0 || xr >= right.cols) {
-        if (unmatched_bad) bad(y, x) = 255;
-        continue;
+  parallelRows(left.rows, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < left.cols; ++x) {
+        if (!keep.empty() && keep[y * left.cols + x]) continue;
+        const float d = left(y, x);
+        const int xr = static_cast<int>(std::lround(x - d));
+        if (xr < 0 || xr >= right.cols) {
+          if (unmatched_bad) bad(y, x) = 255;
+          continue;
+        }
+        if (std::abs(right(y, xr) - d) > max_diff) bad(y, x) = 255;
       }
-      if (std::abs(right(y, xr) - d) > max_diff) bad(y, x) = 255;
     }
-  }
+  });
   return bad;
 }
 
@@ -88,15 +90,16 @@ inline bool priorFills(const ViewState& v, int x, int y, float fill_trust) {
 void fillFromPrior(const ViewState& v, cv::Mat1b& bad, float fill_trust, cv::Mat1f& disparity,
                    int threads) {
   if (v.prior.empty()) return;
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < v.height; ++y) {
-    for (int x = 0; x < v.width; ++x) {
-      if (bad(y, x) && priorFills(v, x, y, fill_trust)) {
-        disparity(y, x) = v.prior(y, x);
-        bad(y, x) = 0;
+  parallelRows(v.height, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < v.width; ++x) {
+        if (bad(y, x) && priorFills(v, x, y, fill_trust)) {
+          disparity(y, x) = v.prior(y, x);
+          bad(y, x) = 0;
+        }
       }
     }
-  }
+  });
 }
 
 /// Bleyer's fill of row y: each bad pixel takes the lower (background) disparity of the planes of
@@ -168,49 +171,78 @@ int medianWindow(const ViewState& v, const cv::Mat1f& filled, int x, int y, int 
 void weightedMedianFilter(const ViewState& v, const cv::Mat1b& bad, const cv::Mat1f& filled,
                           const FillOptions& o, cv::Mat1f& disparity, int threads) {
   const std::vector<float> lut = colourWeightTable(o.delta);
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-  for (int y = 0; y < v.height; ++y) {
-    // At most radius + 1 samples per axis (every second of 2 radius + 1), and the padding.
-    const int most = (o.radius + 1) * (o.radius + 1);
-    std::vector<float> ds(most + kMedianLanes), ws(most + kMedianLanes);
-    for (int x = 0; x < v.width; ++x) {
-      if (!bad(y, x)) continue;
-      float total;
-      const int n = medianWindow(v, filled, x, y, o.radius, lut, ds.data(), ws.data(), total);
-      if (n > 0) disparity(y, x) = weightedMedian(ds.data(), ws.data(), n, 0.5f * total, o.simd);
+  parallelRows(v.height, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      // At most radius + 1 samples per axis (every second of 2 radius + 1), and the padding.
+      const int most = (o.radius + 1) * (o.radius + 1);
+      std::vector<float> ds(most + kMedianLanes), ws(most + kMedianLanes);
+      for (int x = 0; x < v.width; ++x) {
+        if (!bad(y, x)) continue;
+        float total;
+        const int n = medianWindow(v, filled, x, y, o.radius, lut, ds.data(), ws.data(), total);
+        if (n > 0) disparity(y, x) = weightedMedian(ds.data(), ws.data(), n, 0.5f * total, o.simd);
+      }
     }
+  });
+}
+
+}  // namespace
+
+namespace {
+
+/// One row of resultFromLevelBelow.
+void resultFromLevelBelowRow(const ViewState& v, const PatchMatchResult& below, int scale,
+                             bool lr_check, float fill_trust, int y, PatchMatchResult& out) {
+  const bool with_planes = !out.planes.empty();
+  const bool has_prior = !v.prior.empty();
+  const float s = static_cast<float>(scale);
+  const int yb = std::min(below.planes.rows - 1, y / scale);
+  const cv::Vec3f* below_planes = below.planes[yb];
+  const float* below_disparity = below.disparity[yb];
+  const uchar* below_bad = lr_check ? below.inconsistent[yb] : nullptr;
+  cv::Vec3f* planes = with_planes ? out.planes[y] : nullptr;
+  float* disparity = out.disparity[y];
+  uchar* bad = out.inconsistent[y];
+  for (int x = 0; x < v.width; ++x) {
+    const int xb = std::min(below.planes.cols - 1, x / scale);
+    const bool locked = v.locked[y * v.width + x] == kLockedToPrior;
+    const Plane plane = locked ? priorPlane(v, x, y) : upsampledPlane(below_planes[xb], s);
+    if (with_planes) planes[x] = cv::Vec3f(plane.a, plane.b, plane.c);
+    float d = plane.at(static_cast<float>(x), static_cast<float>(y));
+    // The LiDAR measured a locked pixel: the check keeps it.
+    bad[x] = !locked && below_bad != nullptr && below_bad[xb] ? 255 : 0;
+    if (bad[x])
+      d = has_prior && priorFills(v, x, y, fill_trust) ? v.prior(y, x) : s * below_disparity[xb];
+    disparity[x] = d > 0.f && std::isfinite(d) ? d : 0.f;  // empty: nothing could fill it
   }
 }
 
 }  // namespace
 
-void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, int scale,
-                   float fill_trust, cv::Mat1f& disparity, int threads) {
-  const bool has_prior = !v.prior.empty();
-  const float s = static_cast<float>(scale);
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* below_row = below[std::min(below.rows - 1, y / scale)];
-    for (int x = 0; x < disparity.cols; ++x) {
-      if (!bad(y, x)) continue;
-      if (has_prior && priorFills(v, x, y, fill_trust)) {
-        disparity(y, x) = v.prior(y, x);
-        bad(y, x) = 0;
-      } else {
-        disparity(y, x) = s * below_row[std::min(below.cols - 1, x / scale)];
-      }
+PatchMatchResult resultFromLevelBelow(const ViewState& v, const PatchMatchResult& below, int scale,
+                                      bool lr_check, float fill_trust, bool planes, int threads) {
+  const cv::Size size(v.width, v.height);
+  PatchMatchResult out;
+  if (planes) out.planes.create(size);
+  out.disparity.create(size);
+  out.inconsistent.create(size);
+  parallelRows(size.height, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      resultFromLevelBelowRow(v, below, scale, lr_check, fill_trust, y, out);
     }
-  }
+  });
+  return out;
 }
 
 void fillHoles(const ViewState& v, cv::Mat1b bad, const FillOptions& options, cv::Mat1f& disparity,
                int threads) {
   fillFromPrior(v, bad, options.fill_trust, disparity, threads);
   cv::Mat1f filled = disparity.clone();
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threads)
-  for (int y = 0; y < v.height; ++y) {
-    fillRowFromBackground(v, bad, y, options.max_disparity, filled[y]);
-  }
+  parallelRows(v.height, threads, [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      fillRowFromBackground(v, bad, y, options.max_disparity, filled[y]);
+    }
+  });
   filled.copyTo(disparity);  // same size: no new allocation
   weightedMedianFilter(v, bad, filled, options, disparity, threads);
 }

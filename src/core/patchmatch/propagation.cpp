@@ -11,6 +11,8 @@
 #include <thread>
 #include <vector>
 
+#include "lidar_stereo_fusion/core/patchmatch/parallel.h"
+
 namespace lidar_stereo_fusion {
 namespace patchmatch {
 
@@ -191,24 +193,29 @@ void PlaneSearch::refine(int x, int y, const WindowCache& cache, Rng& rng, Plane
   }
   float dn = 1.f;
   const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+  // The best plane's normal, computed again only when a candidate replaces it.
+  float best_nx = 0.f, best_ny = 0.f, best_nz = 0.f;
+  bool normal_known = false;
   while (dd >= kMinRefineStep) {
     const float d = best.at(fx, fy) + rng.uniform(-dd, dd);
     Plane candidate{0.f, 0.f, d};
     if (p_.slanted) {
-      float nx, ny, nz;
-      normalOf(best, nx, ny, nz);
-      nx += rng.uniform(-dn, dn);
-      ny += rng.uniform(-dn, dn);
-      nz += rng.uniform(-dn, dn);
+      if (!normal_known) normalOf(best, best_nx, best_ny, best_nz);
+      normal_known = true;
+      const float nx = best_nx + rng.uniform(-dn, dn);
+      const float ny = best_ny + rng.uniform(-dn, dn);
+      const float nz = best_nz + rng.uniform(-dn, dn);
       const float norm = std::sqrt(nx * nx + ny * ny + nz * nz);
       if (norm > 1e-6f && std::abs(nz / norm) >= kMinNormalZ) {
-        candidate = planeFromNormal(fx, fy, d, nx / norm, ny / norm, std::abs(nz) / norm);
-        if (nz < 0.f) candidate = planeFromNormal(fx, fy, d, -nx / norm, -ny / norm, -nz / norm);
+        candidate = nz < 0.f ? planeFromNormal(fx, fy, d, -nx / norm, -ny / norm, -nz / norm)
+                             : planeFromNormal(fx, fy, d, nx / norm, ny / norm, nz / norm);
       } else {
         candidate = Plane{best.a, best.b, d - best.a * fx - best.b * fy};
       }
     }
+    const float before = best_cost;
     tryPlane(x, y, candidate, cache, best, best_cost);
+    if (best_cost != before) normal_known = false;
     dd *= 0.5f;
     dn *= 0.5f;
   }
@@ -263,15 +270,16 @@ int threadCount(const PatchMatchParams& p) {
 void initialise(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int view) {
   // The cost of an initial plane is computed when the pixel is first visited (currentCost), with
   // the window the visit builds anyway; locked pixels are never compared.
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threadCount(p))
-  for (int y = 0; y < v.height; ++y) {
-    for (int x = 0; x < v.width; ++x) {
-      const int idx = y * v.width + x;
-      Rng rng(streamKey(p.seed, view, -1, idx));
-      v.planes[idx] = search.initialPlane(x, y, rng);
-      v.cost[idx] = kUnknownCost;
+  parallelRows(v.height, threadCount(p), [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < v.width; ++x) {
+        const int idx = y * v.width + x;
+        Rng rng(streamKey(p.seed, view, -1, idx));
+        v.planes[idx] = search.initialPlane(x, y, rng);
+        v.cost[idx] = kUnknownCost;
+      }
     }
-  }
+  });
 }
 
 void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, int iteration) {
@@ -298,30 +306,26 @@ void sweep(const PlaneSearch& search, ViewState& v, const PatchMatchParams& p, i
   // which never wait themselves.
   std::unique_ptr<std::atomic<bool>[]> done(new std::atomic<bool>[strips]);
   for (int i = 0; i < strips; ++i) done[i].store(false, std::memory_order_relaxed);
-  std::atomic<int> next{0};
   const auto ready = [&](int strip) {
     return strip < 0 || strip >= strips || done[strip].load(std::memory_order_acquire);
   };
-#pragma omp parallel num_threads(threads)
-  {
-    WindowCache cache;
-    for (int i = next.fetch_add(1); i < strips; i = next.fetch_add(1)) {
-      const int strip = order[i];
-      if (strip % 2 != first_parity) {
-        while (!ready(strip - 1) || !ready(strip + 1)) std::this_thread::yield();
-      }
-      const int y0 = strip * kStripRows;
-      const int y1 = std::min(v.height, y0 + kStripRows);
-      if (forward) {
-        for (int y = y0; y < y1; ++y)
-          for (int x = 0; x < v.width; ++x) search.processPixel(x, y, true, iteration, cache);
-      } else {
-        for (int y = y1 - 1; y >= y0; --y)
-          for (int x = v.width - 1; x >= 0; --x) search.processPixel(x, y, false, iteration, cache);
-      }
-      done[strip].store(true, std::memory_order_release);
+  parallelFor(strips, threads, [&](int i) {
+    const int strip = order[i];
+    if (strip % 2 != first_parity) {
+      while (!ready(strip - 1) || !ready(strip + 1)) std::this_thread::yield();
     }
-  }
+    WindowCache cache;
+    const int y0 = strip * kStripRows;
+    const int y1 = std::min(v.height, y0 + kStripRows);
+    if (forward) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = 0; x < v.width; ++x) search.processPixel(x, y, true, iteration, cache);
+    } else {
+      for (int y = y1 - 1; y >= y0; --y)
+        for (int x = v.width - 1; x >= 0; --x) search.processPixel(x, y, false, iteration, cache);
+    }
+    done[strip].store(true, std::memory_order_release);
+  });
 }
 
 }  // namespace patchmatch

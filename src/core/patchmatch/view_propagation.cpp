@@ -2,6 +2,7 @@
 // other view (propagation.h).
 #include <cmath>
 
+#include "lidar_stereo_fusion/core/patchmatch/parallel.h"
 #include "lidar_stereo_fusion/core/patchmatch/propagation.h"
 
 namespace lidar_stereo_fusion {
@@ -32,40 +33,42 @@ int transferTarget(const ViewState& src, const PlaneSearch& dst_search, const Vi
 
 void propagateView(const ViewState& src, const PlaneSearch& dst_search, ViewState& dst,
                    const PatchMatchParams& p, bool left_to_right) {
-#pragma omp parallel for schedule(dynamic, 4) num_threads(threadCount(p))
-  for (int y = 0; y < src.height; ++y) {
+  parallelRows(src.height, threadCount(p), [&](int y0, int y1) {
     WindowCache cache;
-    for (int x = 0; x < src.width; ++x) {
-      Plane moved;
-      const int idx = transferTarget(src, dst_search, dst, x, y, left_to_right, moved);
-      if (idx < 0) continue;
-      const int xq = idx - y * dst.width;
-      Plane best = dst.planes[idx];
-      dst_search.cost().buildWindow(xq, y, cache);
-      float best_cost = dst_search.currentCost(idx, cache);
-      dst_search.tryPlane(xq, y, moved, cache, best, best_cost);
-      dst.planes[idx] = best;
-      dst.cost[idx] = best_cost;
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 0; x < src.width; ++x) {
+        Plane moved;
+        const int idx = transferTarget(src, dst_search, dst, x, y, left_to_right, moved);
+        if (idx < 0) continue;
+        const int xq = idx - y * dst.width;
+        Plane best = dst.planes[idx];
+        dst_search.cost().buildWindow(xq, y, cache);
+        float best_cost = dst_search.currentCost(idx, cache);
+        dst_search.tryPlane(xq, y, moved, cache, best, best_cost);
+        dst.planes[idx] = best;
+        dst.cost[idx] = best_cost;
+      }
     }
-  }
+  });
 }
 
 void offerView(const ViewState& src, const PlaneSearch& dst_search, ViewState& dst,
                const PatchMatchParams& p, bool left_to_right) {
-#pragma omp parallel for schedule(static) num_threads(threadCount(p))
-  for (int y = 0; y < src.height; ++y) {
-    // Source pixels in the order in which a nearer surface comes after a farther one that maps
-    // to the same pixel (left -> right: increasing x; right -> left: decreasing x), so that the
-    // last offer made to a pixel is the surface its view sees.
-    for (int i = 0; i < src.width; ++i) {
-      const int x = left_to_right ? i : src.width - 1 - i;
-      Plane moved;
-      const int idx = transferTarget(src, dst_search, dst, x, y, left_to_right, moved);
-      if (idx < 0) continue;
-      dst.offer[idx] = moved;
-      dst.offered[idx] = 1;
+  parallelRows(src.height, threadCount(p), [&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      // Source pixels in the order in which a nearer surface comes after a farther one that maps
+      // to the same pixel (left -> right: increasing x; right -> left: decreasing x), so that
+      // the last offer made to a pixel is the surface its view sees.
+      for (int i = 0; i < src.width; ++i) {
+        const int x = left_to_right ? i : src.width - 1 - i;
+        Plane moved;
+        const int idx = transferTarget(src, dst_search, dst, x, y, left_to_right, moved);
+        if (idx < 0) continue;
+        dst.offer[idx] = moved;
+        dst.offered[idx] = 1;
+      }
     }
-  }
+  });
 }
 
 }  // namespace patchmatch

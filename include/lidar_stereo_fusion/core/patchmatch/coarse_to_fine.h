@@ -18,10 +18,18 @@ namespace patchmatch {
 /// A view's input reduced by `scale`: images by area averaging, prior, confidence and bounds by
 /// nearest neighbour with disparities divided by `scale`.
 ViewInput downsampleView(const ViewInput& in, int scale);
+/// The same into `out`, reusing its buffers where they have the size.
+void downsampleView(const ViewInput& in, int scale, ViewInput& out);
 
 /// Parameters of the coarse level: window radius and stride, disparity range and refinement floor
 /// divided by coarse_scale (at least 1 / a positive range), no left-right check, no coarse start.
 PatchMatchParams coarseParams(const PatchMatchParams& p);
+
+/// The full-size plane of coarse plane q = (a, b, c) (upsamplePlanes).
+inline Plane upsampledPlane(const cv::Vec3f& q, float scale) {
+  const float offset = 0.5f * (scale - 1.f);
+  return Plane{q[0], q[1], scale * q[2] - offset * (q[0] + q[1])};
+}
 
 /// Full-size planes from the coarse level's plane map (a, b, c) per coarse pixel: pixel (x, y)
 /// takes the plane of coarse pixel (x / scale, y / scale), which at full size (coarse pixel

@@ -24,12 +24,17 @@ cv::Mat1b leftRightCheck(const cv::Mat1f& left, const cv::Mat1f& right, float ma
                          const std::vector<uint8_t>& keep, bool unmatched_bad = false,
                          int threads = 1);
 
-/// Fills the pixels marked in `bad` (modified) from a level below that checked and filled its
-/// own (PatchMatchParams::search_scale): where the view's prior has a value and its
-/// trust is >= fill_trust, the prior (as fillHoles); elsewhere `scale` times the level below's
-/// disparity at (x / scale, y / scale).
-void fillFromBelow(const ViewState& v, cv::Mat1b bad, const cv::Mat1f& below, int scale,
-                   float fill_trust, cv::Mat1f& disparity, int threads = 1);
+/// The result of a level that does not search (PatchMatchParams::search_scale) from the level
+/// below's, `scale` times smaller: each pixel's plane is the prior's where `v` locks it to the
+/// prior (priorPlane), else the level below's up-sampled (upsampledPlane), and its disparity the
+/// plane's; with `lr_check`, the pixels the level below's check marks (not those locked) are
+/// marked in `inconsistent` and filled: by the prior where it has a value and its trust is >=
+/// fill_trust (as fillHoles), else by `scale` times the level below's filled disparity at (x /
+/// scale, y / scale). Non-positive or non-finite disparities become 0 (empty). The plane map
+/// only with `planes`.
+PatchMatchResult resultFromLevelBelow(const ViewState& v, const PatchMatchResult& below, int scale,
+                                      bool lr_check, float fill_trust, bool planes = true,
+                                      int threads = 1);
 
 /// How fillHoles fills (PatchMatchParams' median_radius, weight_delta, fill_confidence,
 /// max_disparity and simd_path).
