@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lidar_stereo_fusion/core/patchmatch.h"
 #include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
 #include "lidar_stereo_fusion/core/patchmatch/post_processing.h"
 #include "patchmatch_steps_util.h"

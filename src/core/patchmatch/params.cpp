@@ -1,10 +1,10 @@
-// PatchMatch: the parameters' checks (PatchMatchParams::validate, patchmatch.h).
+// PatchMatch: the parameters' checks (PatchMatchParams::validate, patchmatch/params.h).
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "lidar_stereo_fusion/core/param_table.h"
-#include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/params.h"
 
 namespace lidar_stereo_fusion {
 

@@ -9,7 +9,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/params.h"
 #include "lidar_stereo_fusion/core/patchmatch/plane.h"
 
 namespace lidar_stereo_fusion {

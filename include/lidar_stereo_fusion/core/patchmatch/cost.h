@@ -22,8 +22,8 @@
 
 #include <vector>
 
-#include "lidar_stereo_fusion/core/patchmatch.h"
 #include "lidar_stereo_fusion/core/patchmatch/cost_kernel.h"
+#include "lidar_stereo_fusion/core/patchmatch/params.h"
 #include "lidar_stereo_fusion/core/patchmatch/plane.h"
 #include "lidar_stereo_fusion/core/patchmatch/view_state.h"
 

@@ -27,8 +27,8 @@
 //    iteration, pixel), so the result does not depend on the number of threads.
 #pragma once
 
-#include "lidar_stereo_fusion/core/patchmatch.h"
 #include "lidar_stereo_fusion/core/patchmatch/cost.h"
+#include "lidar_stereo_fusion/core/patchmatch/params.h"
 #include "lidar_stereo_fusion/core/patchmatch/plane.h"
 #include "lidar_stereo_fusion/core/patchmatch/view_state.h"
 
