@@ -93,45 +93,46 @@ cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
   return confidence;
 }
 
-int fillPriorHoles(cv::Mat1f& prior, cv::Mat1f& confidence, const PriorConfidenceParams& params) {
-  params.validate();
-  if (prior.size() != confidence.size()) {
-    throw std::invalid_argument("fillPriorHoles: prior and confidence differ in size");
-  }
-  if (params.hole_confidence <= 0) return 0;
-  const float hole = static_cast<float>(params.hole_confidence);
+namespace {
+
+/// The hole fill's writes: a filled pixel takes the value at the hole fill's confidence.
+struct HoleFill {
+  cv::Mat1f& prior;
+  cv::Mat1f& confidence;
+  float hole;
   int filled = 0;
-  auto set = [&](int y, int x, float value) {
+  void set(int y, int x, float value) {
     prior(y, x) = value;
     confidence(y, x) = hole;
     ++filled;
-  };
-  // The LiDAR's view of each column starts at its top value. A row crosses the tops of many
-  // columns: the top beam's arc spans rows, and a near object's top point sits higher in the image
-  // than a far one's (the LiDAR is above the camera). A row fill that carried a near object's
-  // disparity sideways above a column's top would paint near planes over the far surfaces there
-  // (bands along the top scan line). So above its top value, a column takes a fill value only if
-  // it is no nearer than that top value (+ edge_tolerance): the same surface seen by a neighbour
-  // where this column's top beam returned nothing, or one behind it.
+  }
+};
+
+/// Rows: a gap between two values takes the nearer (larger) one; the row ends take the first and
+/// last value. The LiDAR's view of each column starts at its top value. A row crosses the tops of
+/// many columns: the top beam's arc spans rows, and a near object's top point sits higher in the
+/// image than a far one's (the LiDAR is above the camera). A row fill that carried a near object's
+/// disparity sideways above a column's top would paint near planes over the far surfaces there
+/// (bands along the top scan line). So above its top value, a column takes a fill value only if it
+/// is no nearer than that top value (+ tolerance): the same surface seen by a neighbour where this
+/// column's top beam returned nothing, or one behind it.
+void fillRows(HoleFill& f, float tolerance) {
+  const cv::Mat1f& prior = f.prior;
   std::vector<int> top(static_cast<size_t>(prior.cols), prior.rows);
   std::vector<float> top_value(static_cast<size_t>(prior.cols),
                                std::numeric_limits<float>::infinity());
   for (int y = prior.rows - 1; y >= 0; --y) {
-    const float* d = prior[y];
     for (int x = 0; x < prior.cols; ++x) {
-      if (d[x] > 0.f) {
+      if (prior(y, x) > 0.f) {
         top[x] = y;
-        top_value[x] = d[x];
+        top_value[x] = prior(y, x);
       }
     }
   }
-  const float tolerance = static_cast<float>(params.edge_tolerance);
-  // Rows: a gap between two values takes the nearer (larger) one; the row ends take the first and
-  // last value.
   for (int y = 0; y < prior.rows; ++y) {
     const float* d = prior[y];
     const auto fill = [&](int u, float value) {
-      if (y >= top[u] || value <= top_value[u] + tolerance) set(y, u, value);
+      if (y >= top[u] || value <= top_value[u] + tolerance) f.set(y, u, value);
     };
     int last = -1;  // column of the last value seen in this row
     for (int x = 0; x < prior.cols; ++x) {
@@ -142,20 +143,37 @@ int fillPriorHoles(cv::Mat1f& prior, cv::Mat1f& confidence, const PriorConfidenc
     }
     for (int u = last + 1; last >= 0 && u < prior.cols; ++u) fill(u, d[last]);
   }
-  // Columns: below the bottom value, the bottom value (the ground the LiDAR's lowest beam missed).
+}
+
+/// Columns: below the bottom value, the bottom value (the ground the LiDAR's lowest beam missed);
+/// above the top value, the top value for `top_rows` rows.
+void fillColumnEnds(HoleFill& f, int top_rows) {
+  const cv::Mat1f& prior = f.prior;
   for (int x = 0; x < prior.cols; ++x) {
     int y = prior.rows - 1;
     while (y >= 0 && !(prior(y, x) > 0.f)) --y;
-    for (int v = y + 1; y >= 0 && v < prior.rows; ++v) set(v, x, prior(y, x));
+    for (int v = y + 1; y >= 0 && v < prior.rows; ++v) f.set(v, x, prior(y, x));
   }
-  // Columns: above the top value, that value for top_extension_rows rows.
   for (int x = 0; x < prior.cols; ++x) {
     int y = 0;
     while (y < prior.rows && !(prior(y, x) > 0.f)) ++y;
     if (y == prior.rows) continue;
-    for (int v = std::max(0, y - params.top_extension_rows); v < y; ++v) set(v, x, prior(y, x));
+    for (int v = std::max(0, y - top_rows); v < y; ++v) f.set(v, x, prior(y, x));
   }
-  return filled;
+}
+
+}  // namespace
+
+int fillPriorHoles(cv::Mat1f& prior, cv::Mat1f& confidence, const PriorConfidenceParams& params) {
+  params.validate();
+  if (prior.size() != confidence.size()) {
+    throw std::invalid_argument("fillPriorHoles: prior and confidence differ in size");
+  }
+  if (params.hole_confidence <= 0) return 0;
+  HoleFill fill{prior, confidence, static_cast<float>(params.hole_confidence)};
+  fillRows(fill, static_cast<float>(params.edge_tolerance));
+  fillColumnEnds(fill, params.top_extension_rows);
+  return fill.filled;
 }
 
 }  // namespace lidar_stereo_fusion
