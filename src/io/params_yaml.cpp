@@ -193,10 +193,35 @@ void YamlParamReader::read(const cv::FileNode& node, const ParamSpec& spec,
   value = word;
 }
 
+namespace {
+
+/// A parameter file is a map. OpenCV 4.6's YAML parser never returns on some documents whose top
+/// level is a sequence ("[m]" or "- ..." followed by more lines; found by fuzz_params_yaml), so a
+/// top-level sequence is refused before it is parsed.
+void requireTopLevelMap(const std::string& raw, const std::string& path) {
+  std::istringstream lines(raw);
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#' || line[first] == '%' ||
+        line.compare(first, 3, "---") == 0 || line.compare(first, 3, "...") == 0) {
+      continue;
+    }
+    if (line[first] == '[' || line[first] == '-') {
+      throw std::runtime_error("params YAML " + path + " line " + std::to_string(number) +
+                               ": top level is not a map (a sequence starts here)");
+    }
+    return;
+  }
+}
+
+}  // namespace
+
 cv::FileStorage openYaml(const std::string& path) {
   const std::string raw = readTextFile(path, "params YAML");
   requireTextFile(raw, path, "params YAML");
   requireYamlMarkersAlone(raw, path, "params YAML");
+  requireTopLevelMap(raw, path);
   const std::string text = withYamlDirective(raw);
   cv::FileStorage fs;
   try {

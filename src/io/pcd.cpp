@@ -334,6 +334,20 @@ void checkAscii(std::istream& in, const Header& header, const Layout& layout,
 }
 
 /// The points of a cloud PCL read, after checking that PCL saw the layout our header gave.
+/// The points of `points` records of layout.stride bytes.
+LidarCloud decodeRecords(const unsigned char* data, std::size_t points, const Header& header,
+                         const Layout& layout) {
+  LidarCloud out;
+  out.reserve(points);
+  for (std::size_t i = 0; i < points; ++i) {
+    const unsigned char* record = data + i * layout.stride;
+    out.push_back(makePoint(layout, [&](int f) {
+      return decodeBinary(record + layout.offset[f], header.types[f], header.sizes[f]);
+    }));
+  }
+  return out;
+}
+
 LidarCloud toLidarCloud(const pcl::PCLPointCloud2& cloud, const Header& header,
                         const Layout& layout, const std::string& path) {
   const std::size_t points = static_cast<std::size_t>(cloud.width) * cloud.height;
@@ -344,15 +358,19 @@ LidarCloud toLidarCloud(const pcl::PCLPointCloud2& cloud, const Header& header,
     same = cloud.fields[i].name == header.fields[i] && cloud.fields[i].offset == layout.offset[i];
   }
   if (!same) fail(path, "PCL's reader saw another layout than the header (corrupt header?)");
-  LidarCloud out;
-  out.reserve(points);
-  for (std::size_t i = 0; i < points; ++i) {
-    const unsigned char* record = cloud.data.data() + i * layout.stride;
-    out.push_back(makePoint(layout, [&](int f) {
-      return decodeBinary(record + layout.offset[f], header.types[f], header.sizes[f]);
-    }));
+  return decodeRecords(cloud.data.data(), points, header, layout);
+}
+
+/// DATA binary, read here: PCL 1.13's PCDReader::readBodyBinary reads out of bounds on some
+/// bodies that pass checkBinary (found by fuzz_pcd), and a binary body is only the records.
+LidarCloud readBinaryBody(std::istream& in, const Header& header, const Layout& layout,
+                          const std::string& path) {
+  std::vector<unsigned char> data(header.points * layout.stride);
+  in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(data.size()));
+  if (static_cast<std::size_t>(in.gcount()) != data.size()) {
+    fail(path, "binary data is truncated");
   }
-  return out;
+  return decodeRecords(data.data(), header.points, header, layout);
 }
 
 }  // namespace
@@ -370,6 +388,7 @@ LidarCloud readPcd(const std::string& path, Header* header_out) {
   // This package's checks first (their messages name the problem), then PCL's reader.
   if (header.data == "binary") {
     checkBinary(in, header, layout, path);
+    return readBinaryBody(in, header, layout, path);
   } else if (header.data == "binary_compressed") {
     checkCompressed(in, header, layout, path);
   } else if (header.data == "ascii") {

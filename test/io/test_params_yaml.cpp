@@ -341,6 +341,17 @@ TEST(ParamsYaml, WrongTypesAndInvalidValuesAreErrorsNamingTheKey) {
   EXPECT_NE(invalid.find("window_radius"), std::string::npos) << invalid;
 }
 
+TEST(ParamsYaml, ATopLevelSequenceIsAnErrorBeforeOpenCvParsesIt) {
+  // OpenCV 4.6's parser never returns on these (found by fuzz_params_yaml in CI): a parameter
+  // file is a map, so a top-level sequence is refused first, naming its line.
+  for (const char* text : {"[m]\n.\n-", "[m]\nx\n-", "# c\n\n[m]\n.\n- ", "---\n- a\n"}) {
+    const std::string error = loadError(text);
+    EXPECT_NE(error.find("top level is not a map"), std::string::npos) << error;
+  }
+  EXPECT_NE(loadError("# c\n[m]\n.\n-").find("line 2"), std::string::npos);
+  EXPECT_NE(loadError("[1, 2]\n").find("top level is not a map"), std::string::npos);
+}
+
 TEST(ParamsYaml, ContentOnADocumentMarkerLineIsAnErrorNamingTheLine) {
   // OpenCV's YAML parser loops forever on these (found by fuzzing; text_file.h): they must be
   // rejected before they reach it.
