@@ -50,16 +50,18 @@ InputGate::InputGate(const ros::NodeHandle& nh, const ros::NodeHandle& pnh,
 
   // Synchroniser of the image set (connected once; the filters are (un)subscribed lazily).
   it_ = std::make_shared<image_transport::ImageTransport>(nh_);
-  using boost::placeholders::_1;
-  using boost::placeholders::_2;
-  using boost::placeholders::_3;
-  using boost::placeholders::_4;
+  using boost::placeholders::_1, boost::placeholders::_2, boost::placeholders::_3,
+      boost::placeholders::_4;
   sync_ = std::make_unique<StereoSync>(params_, sub_left_image_, sub_left_info_, sub_right_image_,
                                        sub_right_info_,
                                        boost::bind(&InputGate::imageCb, this, _1, _2, _3, _4),
                                        boost::bind(&InputGate::syncDropCb, this, _1, _2, _3, _4));
-  // Every input topic's arrivals, for the watch (indices as in watch_'s list); the cloud's in
-  // cloudCb.
+  watchInputs();
+}
+
+/// The input watch: every input topic's arrivals (indices as in watch_'s list; the cloud's in
+/// cloudCb) and, with input_timeout, its once-a-second check.
+void InputGate::watchInputs() {
   sub_left_image_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
       [this](const auto&) { watch_.heard(0, watchNow()); }));
   sub_left_info_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(

@@ -75,6 +75,7 @@ class InputGate {
   const TransportChoice& transport() const { return transport_; }
 
  private:
+  void watchInputs();  ///< the constructor's last step: the input watch's callbacks and timer
   using Image = sensor_msgs::Image;
   using Info = sensor_msgs::CameraInfo;
 
