@@ -1,4 +1,5 @@
-// PCD reader: this package's data checks (the header's: pcd_header.cpp) in front of PCL's reader.
+// PCD reader: the header checked in pcd_header.cpp, the body checked and decoded here (PCL's LZF
+// codec for binary_compressed; why not PCL's PCDReader: readCompressedBody).
 #include "lidar_stereo_fusion/io/pcd.h"
 
 #include <algorithm>
@@ -12,8 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <pcl/PCLPointCloud2.h>
-#include <pcl/io/pcd_io.h>
+#include <pcl/io/lzf.h>
 
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "pcd_header.h"
@@ -122,8 +122,8 @@ void checkBinary(std::istream& in, const Header& header, const Layout& layout,
 
 /// The two size words in front of LZF data: PCL checks them too, but only says "corrupted"; these
 /// messages name the numbers, and an impossible size is refused before anything is allocated.
-void checkCompressed(std::istream& in, const Header& header, const Layout& layout,
-                     const std::string& path) {
+uint32_t checkCompressed(std::istream& in, const Header& header, const Layout& layout,
+                         const std::string& path) {
   const std::size_t available = remainingBytes(in);
   uint32_t sizes[2] = {0, 0};  // compressed, uncompressed [bytes]
   if (available < sizeof(sizes)) {
@@ -147,38 +147,41 @@ void checkCompressed(std::istream& in, const Header& header, const Layout& layou
     fail(path, "DATA binary_compressed: " + std::to_string(sizes[0]) +
                    " compressed bytes cannot hold " + std::to_string(expected) + " bytes");
   }
+  return sizes[0];
 }
 
-/// Checks every ascii value. Hand-written on purpose: PCL's reader returns success with 0 for a
-/// word that is no number ("1 2 x") and for missing values ("1 2" under three fields); see
-/// test/core/test_pcd.cpp, Pcl* tests.
-void checkAscii(std::istream& in, const Header& header, const Layout& layout,
-                const std::string& path) {
-  std::size_t points = 0;
+/// DATA ascii, read and checked here: PCL's reader reports success with 0 for a word that is no
+/// number ("1 2 x") and for missing values ("1 2" under three fields); see
+/// test/io/test_pcd_pcl.cpp, Pcl* tests. A field's first value is its value (as in binary).
+LidarCloud readAsciiBody(std::istream& in, const Header& header, const Layout& layout,
+                         const std::string& path) {
+  LidarCloud out;
+  std::vector<double> values(layout.tokens);
   std::string line;
-  while (points < header.points && std::getline(in, line)) {
+  while (out.size() < header.points && std::getline(in, line)) {
     const std::vector<std::string> words = splitWords(line);
     if (words.empty()) continue;
+    const std::string point = std::to_string(out.size());
     if (words.size() != layout.tokens) {
-      fail(path, "ascii point " + std::to_string(points) + " has " + std::to_string(words.size()) +
+      fail(path, "ascii point " + point + " has " + std::to_string(words.size()) +
                      " values, the header says " + std::to_string(layout.tokens));
     }
-    for (const std::string& word : words) {
+    for (std::size_t k = 0; k < words.size(); ++k) {
       char* end = nullptr;
-      std::strtod(word.c_str(), &end);
-      if (end == word.c_str() || *end != '\0') {
-        fail(path, "ascii point " + std::to_string(points) + " has a non-number '" + word + "'");
+      values[k] = std::strtod(words[k].c_str(), &end);
+      if (end == words[k].c_str() || *end != '\0') {
+        fail(path, "ascii point " + point + " has a non-number '" + words[k] + "'");
       }
     }
-    ++points;
+    out.push_back(makePoint(layout, [&](int f) { return values[layout.column[f]]; }));
   }
-  if (points != header.points) {
-    fail(path, "ascii data is truncated: " + std::to_string(points) + " of " +
+  if (out.size() != header.points) {
+    fail(path, "ascii data is truncated: " + std::to_string(out.size()) + " of " +
                    std::to_string(header.points) + " points");
   }
+  return out;
 }
 
-/// The points of a cloud PCL read, after checking that PCL saw the layout our header gave.
 /// The points of `points` records of layout.stride bytes.
 LidarCloud decodeRecords(const unsigned char* data, std::size_t points, const Header& header,
                          const Layout& layout) {
@@ -193,19 +196,6 @@ LidarCloud decodeRecords(const unsigned char* data, std::size_t points, const He
   return out;
 }
 
-LidarCloud toLidarCloud(const pcl::PCLPointCloud2& cloud, const Header& header,
-                        const Layout& layout, const std::string& path) {
-  const std::size_t points = static_cast<std::size_t>(cloud.width) * cloud.height;
-  bool same = points == header.points && cloud.point_step == layout.stride &&
-              cloud.fields.size() == header.fields.size() &&
-              cloud.data.size() >= points * layout.stride;
-  for (std::size_t i = 0; same && i < cloud.fields.size(); ++i) {
-    same = cloud.fields[i].name == header.fields[i] && cloud.fields[i].offset == layout.offset[i];
-  }
-  if (!same) fail(path, "PCL's reader saw another layout than the header (corrupt header?)");
-  return decodeRecords(cloud.data.data(), points, header, layout);
-}
-
 /// DATA binary, read here: PCL 1.13's PCDReader::readBodyBinary reads out of bounds on some
 /// bodies that pass checkBinary (found by fuzz_pcd), and a binary body is only the records.
 LidarCloud readBinaryBody(std::istream& in, const Header& header, const Layout& layout,
@@ -216,6 +206,36 @@ LidarCloud readBinaryBody(std::istream& in, const Header& header, const Layout& 
     fail(path, "binary data is truncated");
   }
   return decodeRecords(data.data(), header.points, header, layout);
+}
+
+/// DATA binary_compressed: PCL's LZF codec (pcl::lzfDecompress), the records decoded here. PCL
+/// 1.13's PCDReader is not used for any body: it crashed on fuzzed files that passed every check
+/// above (ascii and binary bodies, header lines; found by fuzz/fuzz_pcd.cpp in CI runs).
+/// PCL writes the decompressed bytes field by field: all points' x, then all y, ...
+LidarCloud readCompressedBody(std::istream& in, const Header& header, const Layout& layout,
+                              const std::string& path) {
+  const uint32_t compressed = checkCompressed(in, header, layout, path);
+  const std::size_t bytes = header.points * layout.stride;
+  if (bytes == 0) return {};
+  std::vector<unsigned char> packed(compressed);
+  in.read(reinterpret_cast<char*>(packed.data()), static_cast<std::streamsize>(packed.size()));
+  std::vector<unsigned char> data(bytes);
+  const unsigned int got = pcl::lzfDecompress(packed.data(), compressed, data.data(),
+                                              static_cast<unsigned int>(bytes));
+  if (static_cast<std::size_t>(in.gcount()) != packed.size() || got != bytes) {
+    fail(path, "DATA binary_compressed: the LZF data is corrupt (" + std::to_string(got) + " of " +
+                   std::to_string(bytes) + " bytes decompressed)");
+  }
+  LidarCloud out;
+  out.reserve(header.points);
+  for (std::size_t i = 0; i < header.points; ++i) {
+    out.push_back(makePoint(layout, [&](int f) {
+      const std::size_t field_bytes = static_cast<std::size_t>(header.sizes[f]) * header.counts[f];
+      const unsigned char* p = data.data() + header.points * layout.offset[f] + i * field_bytes;
+      return decodeBinary(p, header.types[f], header.sizes[f]);
+    }));
+  }
+  return out;
 }
 
 }  // namespace
@@ -230,34 +250,13 @@ LidarCloud readPcd(const std::string& path, Header* header_out) {
   const Header header = readHeader(in, path);
   const Layout layout = makeLayout(header, path);
   if (header_out) *header_out = header;
-  // This package's checks first (their messages name the problem), then PCL's reader.
   if (header.data == "binary") {
     checkBinary(in, header, layout, path);
     return readBinaryBody(in, header, layout, path);
-  } else if (header.data == "binary_compressed") {
-    checkCompressed(in, header, layout, path);
-  } else if (header.data == "ascii") {
-    checkAscii(in, header, layout, path);
-  } else {
-    fail(path, "unknown DATA '" + header.data + "' (expected ascii, binary or binary_compressed)");
   }
-  in.close();
-  pcl::PCLPointCloud2 cloud;
-  Eigen::Vector4f origin;
-  Eigen::Quaternionf orientation;
-  int version = 0;
-  int status = -1;
-  try {
-    status = pcl::PCDReader().read(path, cloud, origin, orientation, version);
-  } catch (const std::exception& e) {  // pcl::IOException
-    fail(path, std::string("PCL's reader: ") + e.what());
-  }
-  if (status < 0) {
-    fail(path, "PCL's reader refused the DATA " + header.data +
-                   (header.data == "binary_compressed" ? " (corrupt LZF data?)" : "") +
-                   ", status " + std::to_string(status));
-  }
-  return toLidarCloud(cloud, header, layout, path);
+  if (header.data == "binary_compressed") return readCompressedBody(in, header, layout, path);
+  if (header.data == "ascii") return readAsciiBody(in, header, layout, path);
+  fail(path, "unknown DATA '" + header.data + "' (expected ascii, binary or binary_compressed)");
 }
 
 }  // namespace pcd

@@ -77,6 +77,18 @@ void parseViewpoint(const std::string& path, const std::vector<std::string>& val
   if (!numbers) fail(path, "header VIEWPOINT needs 7 numbers (tx ty tz qw qx qy qz)");
 }
 
+/// The place of a header key in the order the PCD format fixes (PCL's reader refuses another
+/// order), or -1 for a key it does not know.
+int keyRank(const std::string& key) {
+  static const char* const kOrder[] = {"VERSION", "FIELDS", "SIZE",      "TYPE",   "COUNT",
+                                       "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+  const std::string name = key == "COLUMNS" ? "FIELDS" : key;
+  for (int i = 0; i < 10; ++i) {
+    if (name == kOrder[i]) return i;
+  }
+  return -1;
+}
+
 /// Reads one header line's key and values into `header`; true at DATA. PCL's reader stops at
 /// the first line it does not know and then reads the file without POINTS (it crashed on such a
 /// file, found by fuzzing): every line must be one it knows, a comment or empty.
@@ -129,6 +141,7 @@ Header readHeader(std::istream& in, const std::string& path) {
   bool have_points = false;
   std::string line;
   int number = 0;
+  int last_rank = -1;
   while (std::getline(in, line)) {
     ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -139,6 +152,13 @@ Header readHeader(std::istream& in, const std::string& path) {
       fail(path, "header line " + std::to_string(number) + " holds only blanks");
     }
     if (words[0][0] == '#') continue;
+    const int rank = keyRank(words[0]);
+    if (rank >= 0 && rank <= last_rank) {
+      fail(path, "header line " + std::to_string(number) + " (" + words[0] +
+                     ") is out of order or repeated (a PCD header holds VERSION, FIELDS, SIZE, "
+                     "TYPE, COUNT, WIDTH, HEIGHT, VIEWPOINT, POINTS, DATA in this order)");
+    }
+    last_rank = rank;
     if (parseHeaderLine(path, words, header, have_points)) break;
   }
   if (header.data.empty()) fail(path, "no DATA line (not a PCD file, or truncated header)");
