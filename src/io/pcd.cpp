@@ -220,8 +220,8 @@ LidarCloud readCompressedBody(std::istream& in, const Header& header, const Layo
   std::vector<unsigned char> packed(compressed);
   in.read(reinterpret_cast<char*>(packed.data()), static_cast<std::streamsize>(packed.size()));
   std::vector<unsigned char> data(bytes);
-  const unsigned int got = pcl::lzfDecompress(packed.data(), compressed, data.data(),
-                                              static_cast<unsigned int>(bytes));
+  const unsigned int got =
+      pcl::lzfDecompress(packed.data(), compressed, data.data(), static_cast<unsigned int>(bytes));
   if (static_cast<std::size_t>(in.gcount()) != packed.size() || got != bytes) {
     fail(path, "DATA binary_compressed: the LZF data is corrupt (" + std::to_string(got) + " of " +
                    std::to_string(bytes) + " bytes decompressed)");

@@ -172,15 +172,17 @@ TEST(PcdPcl, UnknownDataKindIsNamed) {
   writeBytes(tempPath("zip.pcd"),
              "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nPOINTS 1\nDATA zip\n");
   // and a header of known lines in an order PCL refuses (COUNT before TYPE), or one repeated
-  const std::string order = "FIELDS x y z\nSIZE 4 4 4\nCOUNT 1 1 1\nTYPE F F F\nWIDTH 1\n"
-                            "POINTS 1\nDATA ascii\n1 2 3\n";
+  const std::string order =
+      "FIELDS x y z\nSIZE 4 4 4\nCOUNT 1 1 1\nTYPE F F F\nWIDTH 1\n"
+      "POINTS 1\nDATA ascii\n1 2 3\n";
   writeBytes(tempPath("order.pcd"), order);
   pcl::PCLPointCloud2 cloud;
   EXPECT_LT(pcl::PCDReader().read(tempPath("order.pcd"), cloud), 0) << "PCL reads it now";
   EXPECT_NE(readError(tempPath("order.pcd")).find("line 4 (TYPE) is out of order"),
             std::string::npos);
-  writeBytes(tempPath("twice.pcd"), "FIELDS x y z\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
-                                    "WIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n");
+  writeBytes(tempPath("twice.pcd"),
+             "FIELDS x y z\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n"
+             "WIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n");
   EXPECT_NE(readError(tempPath("twice.pcd")).find("line 2 (FIELDS) is out of order or repeated"),
             std::string::npos);
   EXPECT_NE(readError(tempPath("zip.pcd")).find("unknown DATA 'zip'"), std::string::npos);
