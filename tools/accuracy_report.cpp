@@ -50,11 +50,14 @@ Options:
   --methods <list>      comma-separated subset of the rows: fused, paper, lidar_bi, lidar_bf, pms,
                         "lidar_bi else pms", nearest, ip_basic (default all)
   --ip-basic-blur <b>   IP-Basic's last blur: gaussian (the paper's, default), bilateral, none
+  --reference <rule>    dense: how the sweeps' points of a pixel make its reference depth:
+                        nearest (a z-buffer, default) or majority (the depth most sweeps agree
+                        on; see doc/accuracy.md, the reference's foreground bias)
   --help                this text
 )";
 
 struct Options {
-  std::string data, params, ip_basic_blur = "gaussian";
+  std::string data, params, ip_basic_blur = "gaussian", reference = "nearest";
   std::set<std::string> methods, layouts;
   bool middlebury = true, kitti = true, dense = true, kitti_pms = true;
   int frames = 0;
@@ -85,7 +88,7 @@ std::string defaultDataDir() {
 Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(argc, argv,
                             {"--data", "--protocols", "--layouts", "--frames", "--params",
-                             "--methods", "--ip-basic-blur"},
+                             "--methods", "--ip-basic-blur", "--reference"},
                             {"--no-kitti-pms"});
   Options o;
   o.data = cl.value("--data", defaultDataDir());
@@ -93,6 +96,7 @@ Options parseOptions(int argc, char** argv) {
   o.kitti_pms = !cl.has("--no-kitti-pms");
   o.params = cl.value("--params", "");
   o.ip_basic_blur = cl.choice("--ip-basic-blur", "gaussian", {"gaussian", "bilateral", "none"});
+  o.reference = cl.choice("--reference", "nearest", {"nearest", "majority"});
   if (cl.has("--methods")) o.methods = splitList(cl.value("--methods"));
   if (cl.has("--layouts")) o.layouts = splitList(cl.value("--layouts"));
   for (const std::string& layout : o.layouts) {
@@ -181,9 +185,13 @@ void printKitti(const lsf::AccuracyOptions& options) {
             << (options.kitti_pms ? "" : " (without pms)") << "\n\n";
 }
 
-void printDense(const lsf::AccuracyOptions& options) {
+void printDense(const lsf::AccuracyOptions& options, const std::string& reference) {
   const auto t = std::chrono::steady_clock::now();
-  const lsf::DenseProtocolResult dense = lsf::runDenseProtocol(options);
+  lsf::kitti::AccumulationParams reference_params;
+  if (reference == "majority") {
+    reference_params.combine = lsf::kitti::AccumulationParams::Combine::kMajority;
+  }
+  const lsf::DenseProtocolResult dense = lsf::runDenseProtocol(options, reference_params);
   std::cout << "## dense: " << dense.layout.description << "\n\n"
             << lsf::formatKittiLayout(dense.layout)
             << "\nPer depth band of the reference depth:\n\n"
@@ -205,7 +213,7 @@ int run(const Options& o) {
                "the fill. Regions: see eval/accuracy_protocols.h.\n\n";
   if (o.middlebury) printMiddlebury(options);
   if (o.kitti) printKitti(options);
-  if (o.dense) printDense(options);
+  if (o.dense) printDense(options, o.reference);
   return 0;
 }
 

@@ -51,7 +51,10 @@ DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
                        std::to_string(center - reference_params.half_span) + "-" +
                        std::to_string(center + reference_params.half_span) + " (" +
                        std::to_string(out.reference.pixels) +
-                       " pixels, the frame's own sweep included)";
+                       " pixels, the frame's own sweep included; " +
+                       (reference_params.combine == kitti::AccumulationParams::Combine::kMajority
+                            ? "per pixel the depth most sweeps agree on)"
+                            : "per pixel the nearest point)");
   return out;
 }
 

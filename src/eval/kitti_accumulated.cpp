@@ -72,6 +72,40 @@ void compare(const cv::Mat1f& own, const cv::Mat1f& other, AccumulatedDepth& out
   out.p90_relative_difference = quantile(0.9);
 }
 
+/// The depth most of `votes` (one per sweep) agree on: the largest group [z, z (1 + tolerance)]
+/// of the sorted votes, the nearer between equal groups; the group's median.
+float majorityDepth(std::vector<float>& votes, double tolerance) {
+  std::sort(votes.begin(), votes.end());
+  std::size_t best_first = 0, best_count = 0;
+  for (std::size_t i = 0; i < votes.size(); ++i) {
+    const auto end = std::upper_bound(votes.begin() + static_cast<long>(i), votes.end(),
+                                      static_cast<float>(votes[i] * (1.0 + tolerance)));
+    const std::size_t count = static_cast<std::size_t>(end - votes.begin()) - i;
+    if (count > best_count) {
+      best_first = i;
+      best_count = count;
+    }
+  }
+  const std::size_t mid = best_first + best_count / 2;
+  return best_count % 2 == 1 ? votes[mid] : 0.5f * (votes[mid - 1] + votes[mid]);
+}
+
+/// AccumulationParams::Combine::kMajority over the per-sweep z-buffers `layers`.
+cv::Mat1f majorityOf(const std::vector<cv::Mat1f>& layers, double tolerance) {
+  cv::Mat1f out(layers.front().size(), kNoDepth);
+  std::vector<float> votes;
+  for (int y = 0; y < out.rows; ++y) {
+    for (int x = 0; x < out.cols; ++x) {
+      votes.clear();
+      for (const cv::Mat1f& layer : layers) {
+        if (layer(y, x) != kNoDepth) votes.push_back(layer(y, x));
+      }
+      if (!votes.empty()) out(y, x) = majorityDepth(votes, tolerance);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void AccumulationParams::validate() const {
@@ -110,11 +144,16 @@ AccumulatedDepth accumulateDepth(const std::vector<PosedSweep>& sweeps, const St
   AccumulatedDepth out;
   out.sweeps = static_cast<int>(sweeps.size());
   cv::Mat1f other_raw = emptyDepth(camera), kept = emptyDepth(camera);
+  std::vector<cv::Mat1f> layers{own};  // kMajority: one z-buffer per sweep
   const double lo = 1.0 - params.tolerance, hi = 1.0 + params.tolerance;
   for (const PosedSweep& s : sweeps) {
     if (s.own) continue;
     zBuffer(s, camera, params, other_raw, always);
-    zBuffer(s, camera, params, kept, [&](int x, int y, float z) {
+    if (params.combine == AccumulationParams::Combine::kMajority)
+      layers.push_back(emptyDepth(camera));
+    cv::Mat1f& into =
+        params.combine == AccumulationParams::Combine::kMajority ? layers.back() : kept;
+    zBuffer(s, camera, params, into, [&](int x, int y, float z) {
       ++out.other_points;
       if (z_max(y, x) <= 0.f) {
         ++out.removed_unverified;
@@ -128,7 +167,9 @@ AccumulatedDepth accumulateDepth(const std::vector<PosedSweep>& sweeps, const St
     });
   }
   compare(own, other_raw, out);
-  out.depth = toReference(cv::min(own, kept));
+  out.depth = toReference(params.combine == AccumulationParams::Combine::kMajority
+                              ? majorityOf(layers, params.tolerance)
+                              : cv::Mat1f(cv::min(own, kept)));
   out.own = own_zero > 0.f;
   out.own_pixels = cv::countNonZero(out.own);
   out.pixels = cv::countNonZero(out.depth);

@@ -97,6 +97,34 @@ TEST(AccumulatedDepth, ComparesTheOtherSweepsWithTheOwnOneBeforeRemoval) {
   EXPECT_NEAR(out.depth(6, 1), 10.f, 1e-5);
 }
 
+// Combine::kMajority: each sweep's point in a pixel is one vote; the largest group within 5 % wins
+// (its median), the nearer between equal groups. A depth step of the own sweep (10 m left of
+// column 6, 12 m from it) lets both depths pass the window check beside it.
+TEST(AccumulatedDepth, MajorityTakesTheDepthMostSweepsAgreeOn) {
+  kitti::PosedSweep own = ownWall();
+  own.cloud.clear();
+  for (int v = 2; v < 21; v += 4) {
+    for (int u = 0; u <= 10; ++u) own.cloud.push_back(pointAt(u, v, u < 6 ? 10.f : 12.f));
+  }
+  const std::vector<kitti::PosedSweep> sweeps = {
+      own, other({pointAt(6, 4, 10.f), pointAt(5, 8, 10.f), pointAt(6, 6, 10.f)}),
+      other({pointAt(6, 4, 12.f), pointAt(5, 8, 12.f), pointAt(6, 6, 12.2f)}),
+      other({pointAt(6, 4, 12.1f)})};
+  kitti::AccumulationParams params;
+  const kitti::AccumulatedDepth nearest = kitti::accumulateDepth(sweeps, camera(), params);
+  params.combine = kitti::AccumulationParams::Combine::kMajority;
+  const kitti::AccumulatedDepth majority = kitti::accumulateDepth(sweeps, camera(), params);
+  EXPECT_EQ(nearest.removed_disagreeing + nearest.removed_unverified, 0);
+  EXPECT_EQ(majority.pixels, nearest.pixels);
+  EXPECT_NEAR(nearest.depth(4, 6), 10.f, 1e-5);
+  EXPECT_NEAR(majority.depth(4, 6), 12.05f, 1e-5);  // 12.0 and 12.1 against 10.0
+  EXPECT_NEAR(nearest.depth(8, 5), 10.f, 1e-5);
+  EXPECT_NEAR(majority.depth(8, 5), 10.f, 1e-5);  // one vote each: the nearer
+  EXPECT_NEAR(nearest.depth(6, 6), 10.f, 1e-5);
+  EXPECT_NEAR(majority.depth(6, 6), 12.1f, 1e-5);  // own 12.0, 12.2 against 10.0: the median
+  EXPECT_NEAR(majority.depth(2, 0), 10.f, 1e-5);   // the own sweep alone
+}
+
 TEST(AccumulatedDepth, NeedsExactlyOneOwnSweep) {
   kitti::PosedSweep a = ownWall(), b = ownWall();
   EXPECT_THROW(kitti::accumulateDepth({a, b}, camera(), {}), std::invalid_argument);

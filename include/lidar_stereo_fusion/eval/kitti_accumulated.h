@@ -35,6 +35,14 @@ struct AccumulationParams {
   /// Keep the points without an own point in the window (they are counted as removed_unverified
   /// all the same); for measuring what the rule's first half removes.
   bool keep_unverified = false;
+  /// How the kept points of a pixel make its reference depth. kNearest (the default, a z-buffer):
+  /// the nearest. kMajority: each sweep's nearest point in the pixel is one vote; the depth most
+  /// sweeps agree on (the largest group within `tolerance` of its nearest member; between equal
+  /// groups the nearer) wins, as the group's median. Near a depth edge the sweeps' points scatter
+  /// by a pixel or so (poses, rounding), and the nearest of up to 11 then widens every foreground
+  /// object (doc/accuracy.md, "the reference's foreground bias").
+  enum class Combine { kNearest, kMajority };
+  Combine combine = Combine::kNearest;
   /// Throws std::invalid_argument naming the first impossible value.
   void validate() const;
 };
@@ -67,8 +75,8 @@ struct AccumulatedDepth {
 /// point with min_depth <= z <= max_depth is projected (pixel = round(fx x / z + cx), round(fy y /
 /// z + cy), as projectCloud), the own sweep's points as they are, each other sweep's point only
 /// when it agrees with the own sweep by the window rule of AccumulationParams; the nearest point
-/// wins a pixel. Throws std::invalid_argument for an invalid camera or params, or when not exactly
-/// one sweep is `own`.
+/// wins a pixel (or the majority of the sweeps, AccumulationParams::combine). Throws
+/// std::invalid_argument for an invalid camera or params, or when not exactly one sweep is `own`.
 AccumulatedDepth accumulateDepth(const std::vector<PosedSweep>& sweeps, const StereoCamera& camera,
                                  const AccumulationParams& params);
 
