@@ -32,6 +32,7 @@ namespace fs = std::filesystem;
 namespace {
 
 using kitti_runner::createDirectory;
+using kitti_runner::requireApart;
 using kitti_runner::requireWritable;
 using kitti_runner::saveVisualisation;
 
@@ -304,6 +305,8 @@ std::vector<lsf::kitti::Frame> openDrive(const Options& o, std::unique_ptr<Conte
                              " has image_02, image_03 and a velodyne_points .bin");
   }
   if (o.frames > 0 && static_cast<size_t>(o.frames) < frames.size()) frames.resize(o.frames);
+  requireApart(o.out, o.drive, "the drive (--kitti-raw)");
+  if (!o.reference.empty()) requireApart(o.out, o.reference, "the reference folder (--reference)");
   createDirectory(o.out);
   requireWritable(o.out);
   if (o.save_vis) createDirectory(fs::path(o.out) / "vis");

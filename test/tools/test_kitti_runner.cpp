@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <sstream>
 
@@ -173,6 +174,46 @@ TEST(KittiRunner, FusedDefaultAndHoldoutRun) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("fused_bi"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("mean (1 frames)"), std::string::npos) << r.out;
+}
+
+std::string fileBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The output never lands among the inputs: inside the drive (into image_02/data the depth PNGs
+// would replace the images of the same names) or in the reference folder; nothing is written.
+TEST(KittiRunner, AnOutputFolderAmongItsInputsIsRefused) {
+  REQUIRE_RUNNER();
+  SyntheticDrive drive;
+  const fs::path images = drive.drive() / "image_02" / "data";
+  const fs::path first = *fs::directory_iterator(images);
+  const std::string before = fileBytes(first);
+  const size_t files = std::distance(fs::directory_iterator(images), fs::directory_iterator());
+  for (const fs::path& out : {images, drive.drive(), drive.drive() / "new" / "depth"}) {
+    const RunResult r = drive.run("--out " + out.string() + " --method lidar_bi --frames 1");
+    EXPECT_EQ(r.status, 1) << out;
+    EXPECT_NE(r.err.find("is inside the drive (--kitti-raw)"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(fileBytes(first), before);
+  EXPECT_EQ(std::distance(fs::directory_iterator(images), fs::directory_iterator()), files);
+  EXPECT_FALSE(fs::exists(drive.drive() / "new"));
+  // a symbolic link to the drive is the drive
+  const fs::path link = drive.outDir().parent_path() / "drive_link";
+  fs::create_directory_symlink(drive.drive(), link);
+  const RunResult linked =
+      drive.run("--out " + (link / "image_02" / "data").string() + " --method lidar_bi");
+  EXPECT_EQ(linked.status, 1);
+  EXPECT_EQ(fileBytes(first), before);
+  fs::remove(link);
+  // the reference folder
+  const fs::path reference = drive.outDir().parent_path() / "reference";
+  fs::create_directories(reference);
+  const RunResult scored = drive.run("--out " + reference.string() + " --method lidar_bi " +
+                                     "--reference " + reference.string());
+  EXPECT_EQ(scored.status, 1);
+  EXPECT_NE(scored.err.find("is inside the reference folder (--reference)"), std::string::npos)
+      << scored.err;
 }
 
 TEST(KittiRunner, BadCommandLinesExitWith2AndHelpWith0) {

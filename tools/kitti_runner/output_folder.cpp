@@ -36,6 +36,22 @@ void createDirectory(const fs::path& dir) {
   }
 }
 
+void requireApart(const fs::path& out, const fs::path& input, const std::string& what) {
+  std::error_code error;
+  const fs::path inner = fs::weakly_canonical(fs::absolute(out), error);
+  const fs::path outer = fs::weakly_canonical(fs::absolute(input), error);
+  if (error) return;  // the input's own check names it
+  for (fs::path p = inner; !p.empty(); p = p.parent_path()) {
+    if (p == outer) {
+      throw std::runtime_error("output folder " + out.string() + " is inside " + what + " " +
+                               input.string() +
+                               ": kitti_runner does not write among the files it reads (choose a "
+                               "folder outside it)");
+    }
+    if (p == p.parent_path()) break;
+  }
+}
+
 void requireWritable(const fs::path& dir) {
   const fs::path probe = dir / (".kitti_runner_probe_" + std::to_string(::getpid()));
   FILE* file = std::fopen(probe.string().c_str(), "wb");

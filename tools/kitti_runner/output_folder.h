@@ -15,6 +15,12 @@ namespace kitti_runner {
 /// Creates `dir` (and its parents); throws std::runtime_error naming it when that fails.
 void createDirectory(const std::filesystem::path& dir);
 
+/// Throws std::runtime_error naming both when `out` is `input` or lies inside it (symbolic links
+/// resolved): kitti_runner never writes among the files it reads (into a drive's image_02/data
+/// its PNGs would replace the recording's images). `what` names the input ("--kitti-raw").
+void requireApart(const std::filesystem::path& out, const std::filesystem::path& input,
+                  const std::string& what);
+
 /// Fails now, with the reason, when `dir` cannot take files (not after the first frame).
 void requireWritable(const std::filesystem::path& dir);
 
