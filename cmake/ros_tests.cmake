@@ -18,7 +18,9 @@ set(LSF_ROS_TEST_DEFINITIONS
   LSF_DATA_DIR="${LSF_DATA_DIR}" LSF_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}"
   LSF_BINARY_DIR="${CMAKE_CURRENT_BINARY_DIR}")
 
-catkin_add_gtest(test_ros_unit test/ros/test_ros_unit.cpp test/ros/test_ros_params.cpp
+catkin_add_gtest(test_ros_unit test/ros/test_conversions_images.cpp
+  test/ros/test_conversions_clouds.cpp test/ros/test_conversions_outputs.cpp
+  test/ros/test_ros_params.cpp
   test/ros/test_frame_matcher.cpp
   test/ros/test_frame_input.cpp
   test/ros/test_input_attacks.cpp

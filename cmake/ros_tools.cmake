@@ -34,14 +34,18 @@ endforeach()
 # The sweep message: conversions::cloudToMsg, the fields of velodyne_pointcloud.
 target_link_libraries(kitti_to_bag ${PROJECT_NAME}_ros)
 
-# bag_runner: the node's pairing (stereo_sync.h) fed from bags; its parts in a library for tests.
-add_library(${PROJECT_NAME}_bag STATIC src/ros/bag_pairing.cpp src/ros/bag_outputs.cpp
-  src/ros/bag_inputs.cpp src/ros/bag_files.cpp src/ros/bag_manifest.cpp src/ros/bag_run.cpp)
+# bag_runner: the node's pairing (stereo_sync.h) fed from bags; its parts (tools/ros/bag_runner/)
+# in a library for tests, which include them as "bag_runner/bag_<part>.h".
+add_library(${PROJECT_NAME}_bag STATIC tools/ros/bag_runner/bag_pairing.cpp
+  tools/ros/bag_runner/bag_outputs.cpp tools/ros/bag_runner/bag_inputs.cpp
+  tools/ros/bag_runner/bag_files.cpp tools/ros/bag_runner/bag_manifest.cpp
+  tools/ros/bag_runner/bag_run.cpp)
+target_include_directories(${PROJECT_NAME}_bag PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/tools/ros)
 target_link_libraries(${PROJECT_NAME}_bag PUBLIC ${PROJECT_NAME}_ros)
 # The manifest of an output folder names the package version (package.xml, read by catkin).
 target_compile_definitions(${PROJECT_NAME}_bag PRIVATE
   LSF_PACKAGE_VERSION="${${PROJECT_NAME}_VERSION}")
-add_executable(bag_runner src/ros/bag_runner.cpp)
+add_executable(bag_runner tools/ros/bag_runner.cpp)
 target_link_libraries(bag_runner ${PROJECT_NAME}_bag)
 list(APPEND LSF_ROS_TOOLS bag_runner)
 catkin_install_python(PROGRAMS scripts/lsf_batch DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

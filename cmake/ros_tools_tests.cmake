@@ -113,12 +113,20 @@ catkin_run_tests_target("pytest" "lsf_batch" "pytest-lsf_batch.xml"
   COMMAND "${CMAKE_COMMAND} -E env LSF_DATA_DIR=${LSF_DATA_DIR} LSF_BIN_DIR=$<TARGET_FILE_DIR:bag_runner> LSF_SCRATCH=${CMAKE_CURRENT_BINARY_DIR}/test_lsf_batch ${PYTHON_EXECUTABLE} -m pytest -q -p no:cacheprovider --junitxml=${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-lsf_batch.xml ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_lsf_batch.py"
   DEPENDENCIES bag_runner kitti_to_bag)
 
-# Issue 33: recordings as users keep them (compressed images, outputs apart from inputs, resume
-# with a manifest, a swapped pair, bad bags, empty windows, a lost scheduler, chunk floor, an
-# unwritable folder, the PCD layout) and fusion.launch's box corners; pytest, bags written at
-# test time into the build folder.
+# Issue 33: recordings as users keep them; pytest, bags written at test time into the build
+# folder, one pytest command (the modules share its bags: test/ros/bag_tool_setup.py):
+#   test_recordings_outputs.py  outputs apart from inputs, resume with a manifest, a killed run's
+#                               temporary files, an unwritable folder, the PCD layout;
+#   test_recordings_inputs.py   compressed images, a swapped pair, fusion.launch's box corners,
+#                               remaps, bad bags, empty windows;
+#   test_recordings_batch.py    a lost or unreachable scheduler, the chunk floor.
+set(LSF_RECORDINGS_TESTS "")
+foreach(part outputs inputs batch)
+  string(APPEND LSF_RECORDINGS_TESTS
+         " ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_recordings_${part}.py")
+endforeach()
 catkin_run_tests_target("pytest" "recordings" "pytest-recordings.xml"
-  COMMAND "${CMAKE_COMMAND} -E env LSF_DATA_DIR=${LSF_DATA_DIR} LSF_BIN_DIR=$<TARGET_FILE_DIR:bag_runner> LSF_SCRATCH=${CMAKE_CURRENT_BINARY_DIR}/test_recordings ${PYTHON_EXECUTABLE} -m pytest -q -p no:cacheprovider --junitxml=${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-recordings.xml ${CMAKE_CURRENT_SOURCE_DIR}/test/ros/test_recordings.py"
+  COMMAND "${CMAKE_COMMAND} -E env LSF_DATA_DIR=${LSF_DATA_DIR} LSF_BIN_DIR=$<TARGET_FILE_DIR:bag_runner> LSF_SCRATCH=${CMAKE_CURRENT_BINARY_DIR}/test_recordings ${PYTHON_EXECUTABLE} -m pytest -q -p no:cacheprovider --junitxml=${CATKIN_TEST_RESULTS_DIR}/${PROJECT_NAME}/pytest-recordings.xml${LSF_RECORDINGS_TESTS}"
   DEPENDENCIES bag_runner kitti_to_bag)
 
 # Issue 33, the live node: playback.launch image_transport:=compressed on compressed KITTI bags

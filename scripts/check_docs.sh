@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Checks that doc/method.md names only things that exist: every repository path in backticks (a
 # word with a '/' ending in .h .cpp .py .yaml .launch .cfg .test or .md) must be a file of the
-# repository, and every `name()` in backticks (also `Class::name()`) must occur as a word in src/ or
-# include/. Prints each missing one and exits 1; exits 0 when all exist.
+# repository, and every `name()` in backticks (also `Class::name()`) must occur as a word in src/,
+# include/ or tools/ (the tools' own parts, e.g. tools/ros/bag_runner/). Prints each missing one
+# and exits 1; exits 0 when all exist.
 # Usage: bash scripts/check_docs.sh [markdown file...]   (default: doc/method.md)
 set -euo pipefail
 
@@ -40,16 +41,16 @@ for doc in "${docs[@]}"; do
     n_funcs=$((n_funcs + 1))
     name=${f%()}
     name=${name##*::}
-    if ! grep -rqw -- "$name" src include; then
-      echo "check_docs: $doc names \`$f\`, but '$name' occurs nowhere in src/ or include/" >&2
+    if ! grep -rqw -- "$name" src include tools; then
+      echo "check_docs: $doc names \`$f\`, but '$name' occurs nowhere in src/, include/ or tools/" >&2
       bad=1
     fi
     # A scope (Class::) must exist too.
     if [[ $f == *::* ]]; then
       scope=${f%::*}
       scope=${scope##*::}
-      if ! grep -rqw -- "$scope" src include; then
-        echo "check_docs: $doc names \`$f\`, but '$scope' occurs nowhere in src/ or include/" >&2
+      if ! grep -rqw -- "$scope" src include tools; then
+        echo "check_docs: $doc names \`$f\`, but '$scope' occurs nowhere in src/, include/ or tools/" >&2
         bad=1
       fi
     fi

@@ -134,15 +134,22 @@ TEST(IpBasic, EmptyInEmptyOutAndInvalidDepthsAreEmpty) {
   in(2, 7) = -3.f;
   EXPECT_EQ(cv::countNonZero(ipBasicFill(in)), 0);
   EXPECT_THROW(ipBasicFill(cv::Mat1f()), std::invalid_argument);
-  IpBasicParams p;
-  p.closing_kernel = 4;
-  EXPECT_THROW(p.validate(), std::invalid_argument);
-  p = IpBasicParams();
-  p.median_kernel = 7;
-  EXPECT_THROW(p.validate(), std::invalid_argument);
-  p = IpBasicParams();
-  p.max_depth = 0.1;
-  EXPECT_THROW(ipBasicFill(in, p), std::invalid_argument);
+  // Parameters refused by validate(), and so by ipBasicFill(): one change to the defaults each.
+  const struct {
+    const char* what;
+    void (*change)(IpBasicParams&);
+  } refused[] = {
+      {"closing_kernel 4 (even)", [](IpBasicParams& p) { p.closing_kernel = 4; }},
+      {"median_kernel 7 (OpenCV's float median: 1, 3 or 5)",
+       [](IpBasicParams& p) { p.median_kernel = 7; }},
+      {"max_depth 0.1 m", [](IpBasicParams& p) { p.max_depth = 0.1; }},
+  };
+  for (const auto& c : refused) {
+    IpBasicParams p;
+    c.change(p);
+    EXPECT_THROW(p.validate(), std::invalid_argument) << c.what;
+    EXPECT_THROW(ipBasicFill(in, p), std::invalid_argument) << c.what;
+  }
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -48,35 +49,49 @@ const char kPacket[] =
     "49.5 8.25 114.5 0.072 0.0015 -0.27 -2.93 10.28 10.5 0.125 -0.075 0.006 0.845 9.91 0.042 "
     "0.136 9.95 0.0166 -0.0368 0.0033 0.0167 -0.037 0.0006 0.43 0.058 4 7 4 4 0\n";
 
+/// One value of an OXTS packet: its dataformat.txt name, its member and its value in kPacket.
+template <class T>
+struct PacketValue {
+  const char* name;
+  T OxtsPacket::*member;
+  T value;
+};
+
 TEST(KittiOxts, ReadsThe30ValuesOfAPacket) {
   TempDir dir;
   const OxtsPacket p = kitti::readOxtsPacket(dir.write("0000000000.txt", kPacket));
-  EXPECT_EQ(p.lat, 49.5);
-  EXPECT_EQ(p.lon, 8.25);
-  EXPECT_EQ(p.alt, 114.5);
-  EXPECT_EQ(p.roll, 0.072);
-  EXPECT_EQ(p.pitch, 0.0015);
-  EXPECT_EQ(p.yaw, -0.27);
-  EXPECT_EQ(p.vn, -2.93);
-  EXPECT_EQ(p.ve, 10.28);
-  EXPECT_EQ(p.vf, 10.5);
-  EXPECT_EQ(p.vl, 0.125);
-  EXPECT_EQ(p.vu, -0.075);
-  EXPECT_EQ(p.ax, 0.006);
-  EXPECT_EQ(p.az, 9.91);
-  EXPECT_EQ(p.au, 9.95);
-  EXPECT_EQ(p.wx, 0.0166);
-  EXPECT_EQ(p.wz, 0.0033);
-  EXPECT_EQ(p.wf, 0.0167);
-  EXPECT_EQ(p.wl, -0.037);
-  EXPECT_EQ(p.wu, 0.0006);
-  EXPECT_EQ(p.pos_accuracy, 0.43);
-  EXPECT_EQ(p.vel_accuracy, 0.058);
-  EXPECT_EQ(p.navstat, 4);
-  EXPECT_EQ(p.numsats, 7);
-  EXPECT_EQ(p.posmode, 4);
-  EXPECT_EQ(p.velmode, 4);
-  EXPECT_EQ(p.orimode, 0);
+  const PacketValue<double> reals[] = {{"lat", &OxtsPacket::lat, 49.5},
+                                       {"lon", &OxtsPacket::lon, 8.25},
+                                       {"alt", &OxtsPacket::alt, 114.5},
+                                       {"roll", &OxtsPacket::roll, 0.072},
+                                       {"pitch", &OxtsPacket::pitch, 0.0015},
+                                       {"yaw", &OxtsPacket::yaw, -0.27},
+                                       {"vn", &OxtsPacket::vn, -2.93},
+                                       {"ve", &OxtsPacket::ve, 10.28},
+                                       {"vf", &OxtsPacket::vf, 10.5},
+                                       {"vl", &OxtsPacket::vl, 0.125},
+                                       {"vu", &OxtsPacket::vu, -0.075},
+                                       {"ax", &OxtsPacket::ax, 0.006},
+                                       {"ay", &OxtsPacket::ay, 0.845},
+                                       {"az", &OxtsPacket::az, 9.91},
+                                       {"af", &OxtsPacket::af, 0.042},
+                                       {"al", &OxtsPacket::al, 0.136},
+                                       {"au", &OxtsPacket::au, 9.95},
+                                       {"wx", &OxtsPacket::wx, 0.0166},
+                                       {"wy", &OxtsPacket::wy, -0.0368},
+                                       {"wz", &OxtsPacket::wz, 0.0033},
+                                       {"wf", &OxtsPacket::wf, 0.0167},
+                                       {"wl", &OxtsPacket::wl, -0.037},
+                                       {"wu", &OxtsPacket::wu, 0.0006},
+                                       {"pos_accuracy", &OxtsPacket::pos_accuracy, 0.43},
+                                       {"vel_accuracy", &OxtsPacket::vel_accuracy, 0.058}};
+  for (const auto& v : reals) EXPECT_EQ(p.*v.member, v.value) << v.name;
+  const PacketValue<int> integers[] = {{"navstat", &OxtsPacket::navstat, 4},
+                                       {"numsats", &OxtsPacket::numsats, 7},
+                                       {"posmode", &OxtsPacket::posmode, 4},
+                                       {"velmode", &OxtsPacket::velmode, 4},
+                                       {"orimode", &OxtsPacket::orimode, 0}};
+  for (const auto& v : integers) EXPECT_EQ(p.*v.member, v.value) << v.name;
   // Blank lines around the packet and no final newline are fine.
   const std::string text(kPacket);
   EXPECT_EQ(kitti::readOxtsPacket(dir.write("b.txt", "\n" + text.substr(0, text.size() - 1))).vf,
@@ -99,19 +114,24 @@ void expectPacketError(const TempDir& dir, const std::string& text,
 
 TEST(KittiOxts, MalformedPacketsAreNamedByFileLineAndValue) {
   TempDir dir;
-  std::string text(kPacket);
-  expectPacketError(dir, "", {"no packet line"});
-  expectPacketError(dir, "1 2 3\n", {"line 1", "has 3 values, expected 30"});
-  expectPacketError(dir, "\n" + text + text, {"line 3", "a second packet"});
-  std::string bad_vf = text;
-  bad_vf.replace(bad_vf.find("10.5"), 4, "10,5");
-  expectPacketError(dir, bad_vf, {"line 1", "value 9 (vf)", "'10,5'"});
-  std::string nan_yaw = text;
-  nan_yaw.replace(nan_yaw.find("-0.27"), 5, "nan");
-  expectPacketError(dir, nan_yaw, {"value 6 (yaw)", "not a finite number"});
-  std::string half_sat = text;
-  half_sat.replace(half_sat.find(" 7 4 4 0"), 8, " 7.5 4 4 0");
-  expectPacketError(dir, half_sat, {"value 27 (numsats)", "not an integer"});
+  const std::string text(kPacket);
+  /// kPacket with `from` replaced by `to`.
+  const auto edited = [&text](const std::string& from, const std::string& to) {
+    return std::string(text).replace(text.find(from), from.size(), to);
+  };
+  // The file's text, and what the error must say besides the file's path.
+  const struct {
+    std::string text;
+    std::vector<std::string> said;
+  } cases[] = {
+      {"", {"no packet line"}},
+      {"1 2 3\n", {"line 1", "has 3 values, expected 30"}},
+      {"\n" + text + text, {"line 3", "a second packet"}},
+      {edited("10.5", "10,5"), {"line 1", "value 9 (vf)", "'10,5'"}},
+      {edited("-0.27", "nan"), {"value 6 (yaw)", "not a finite number"}},
+      {edited(" 7 4 4 0", " 7.5 4 4 0"), {"value 27 (numsats)", "not an integer"}},
+  };
+  for (const auto& c : cases) expectPacketError(dir, c.text, c.said);
   EXPECT_THROW(kitti::readOxtsPacket(dir.path() + "/none.txt"), std::runtime_error);
 }
 

@@ -4,6 +4,8 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -316,29 +318,27 @@ TEST(ParamsYaml, OpenCvStyleFileWithDirectiveAndEmptyFileAreAccepted) {
   expectSame(q, everyFieldChanged());
 }
 
+/// Per case, a YAML text whose loading fails with each of the parts in the message.
+void expectLoadErrors(const std::vector<std::pair<const char*, std::vector<std::string>>>& cases) {
+  for (const auto& [yaml, said] : cases) {
+    const std::string error = loadError(yaml);
+    for (const auto& part : said) EXPECT_NE(error.find(part), std::string::npos) << error;
+  }
+}
+
 TEST(ParamsYaml, UnknownKeysAreErrorsNamingTheKey) {
-  const std::string in_section = loadError("patchmatch:\n  window_radious: 5\n");
-  EXPECT_NE(in_section.find("'window_radious'"), std::string::npos) << in_section;
-  EXPECT_NE(in_section.find("patchmatch"), std::string::npos) << in_section;
-  const std::string top = loadError("methd: pms\n");
-  EXPECT_NE(top.find("'methd'"), std::string::npos) << top;
+  expectLoadErrors({{"patchmatch:\n  window_radious: 5\n", {"'window_radious'", "patchmatch"}},
+                    {"methd: pms\n", {"'methd'"}}});
 }
 
 TEST(ParamsYaml, WrongTypesAndInvalidValuesAreErrorsNamingTheKey) {
-  const std::string not_number = loadError("bf:\n  sigma_space: wide\n");
-  EXPECT_NE(not_number.find("'sigma_space'"), std::string::npos) << not_number;
-  const std::string not_int = loadError("bi:\n  max_gap_px: 2.5\n");
-  EXPECT_NE(not_int.find("'max_gap_px'"), std::string::npos) << not_int;
-  const std::string not_bool = loadError("patchmatch:\n  slanted: maybe\n");
-  EXPECT_NE(not_bool.find("'slanted'"), std::string::npos) << not_bool;
-  const std::string negative_seed = loadError("patchmatch:\n  seed: -1\n");
-  EXPECT_NE(negative_seed.find("'seed'"), std::string::npos) << negative_seed;
-  const std::string method = loadError("method: magic\n");
-  EXPECT_NE(method.find("magic"), std::string::npos) << method;
-  const std::string section = loadError("bi: 3\n");
-  EXPECT_NE(section.find("'bi'"), std::string::npos) << section;
-  const std::string invalid = loadError("patchmatch:\n  window_radius: -2\n");
-  EXPECT_NE(invalid.find("window_radius"), std::string::npos) << invalid;
+  expectLoadErrors({{"bf:\n  sigma_space: wide\n", {"'sigma_space'"}},   // not a number
+                    {"bi:\n  max_gap_px: 2.5\n", {"'max_gap_px'"}},      // not an integer
+                    {"patchmatch:\n  slanted: maybe\n", {"'slanted'"}},  // not a boolean
+                    {"patchmatch:\n  seed: -1\n", {"'seed'"}},           // a negative seed
+                    {"method: magic\n", {"magic"}},                      // no such method
+                    {"bi: 3\n", {"'bi'"}},                               // a section that is no map
+                    {"patchmatch:\n  window_radius: -2\n", {"window_radius"}}});  // validate()
 }
 
 TEST(ParamsYaml, ATopLevelSequenceIsAnErrorBeforeOpenCvParsesIt) {

@@ -12,8 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include "lidar_stereo_fusion/ros/bag_files.h"
-#include "lidar_stereo_fusion/ros/bag_manifest.h"
+#include "bag_runner/bag_files.h"
+#include "bag_runner/bag_manifest.h"
 
 namespace fs = std::filesystem;
 namespace lsf = lidar_stereo_fusion;

@@ -13,7 +13,6 @@ Missing data fails under CI=true and skips otherwise. No timing is asserted."""
 import csv
 import glob
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -24,47 +23,21 @@ import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import batch_bags  # noqa: E402
+import bag_tool_setup  # noqa: E402
+from bag_tool_setup import (BAG_RUNNER, DEADLINE, LSF_BATCH, SCRATCH, SOURCE,  # noqa: E402
+                            batch, run)
 
-BIN = os.environ.get("LSF_BIN_DIR", "")
-DATA = os.environ.get("LSF_DATA_DIR", "")
-SCRATCH = os.environ.get("LSF_SCRATCH", "/tmp/lsf_batch_test")
-BAG_RUNNER = os.path.join(BIN, "bag_runner")
-KITTI_TO_BAG = os.path.join(BIN, "kitti_to_bag")
-LSF_BATCH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts",
-                         "lsf_batch")
-FRAMES = [["0000000000", "0000000005"], ["0000000010", "0000000015"],
+FRAMES = [bag_tool_setup.TWO_FRAMES, ["0000000010", "0000000015"],
           ["0000000020", "0000000025"]]
-DEADLINE = 300  # [s] for any one command: a hang fails, nothing is timed
 
 
 def setup_module():
-    if not os.path.isdir(os.path.join(DATA, batch_bags.DATE, batch_bags.DRIVE)):
-        message = "KITTI sample drive missing under LSF_DATA_DIR=%r" % DATA
-        if os.environ.get("CI") == "true":
-            pytest.fail(message)
-        pytest.skip(message, allow_module_level=True)
-    shutil.rmtree(SCRATCH, ignore_errors=True)
-    os.makedirs(SCRATCH)
-
-
-def run(command, **kwargs):
-    return subprocess.run([str(c) for c in command], stdout=subprocess.PIPE,
-                          stderr=subprocess.PIPE, universal_newlines=True, timeout=DEADLINE,
-                          env=dict(os.environ, OMP_NUM_THREADS="1"), **kwargs)
-
-
-def batch(*args):
-    return run([sys.executable, LSF_BATCH, "--bag-runner", BAG_RUNNER, "--workers", 2,
-                "--threads-per-worker", 1] + list(args))
+    bag_tool_setup.prepare()
 
 
 def pngs(folder):
-    """{file name: bytes} of the PNGs under `folder`."""
-    found = {}
-    for path in glob.glob(os.path.join(folder, "**", "*.png"), recursive=True):
-        with open(path, "rb") as f:
-            found[os.path.relpath(path, folder)] = f.read()
-    return found
+    """{path relative to `folder`: bytes} of the PNGs under `folder`, sub-folders included."""
+    return bag_tool_setup.pngs(folder, recursive=True)
 
 
 def rows(folder):
@@ -76,10 +49,7 @@ def rows(folder):
 
 @pytest.fixture(scope="module")
 def bags():
-    paths = [batch_bags.kitti_bag(KITTI_TO_BAG, DATA, SCRATCH, frames,
-                                  os.path.join(SCRATCH, "drive%d.bag" % i))
-             for i, frames in enumerate(FRAMES)]
-    return paths
+    return [bag_tool_setup.kitti_bag("drive%d" % i, frames) for i, frames in enumerate(FRAMES)]
 
 
 @pytest.fixture(scope="module")
@@ -98,9 +68,7 @@ def serial(bags):
 @pytest.fixture(scope="module")
 def long_bag():
     """3 frames restamped at 10 Hz, 3 times: 9 image sets over 0.9 s."""
-    return batch_bags.kitti_bag(KITTI_TO_BAG, DATA, SCRATCH, FRAMES[0] + ["0000000010"],
-                                os.path.join(SCRATCH, "long.bag"),
-                                ["--period", "0.1", "--cycles", "3"])
+    return bag_tool_setup.long_bag()
 
 
 def test_bag_runner_writes_a_named_png_and_row_per_set(bags, serial):
@@ -145,7 +113,7 @@ def test_bag_runner_optional_outputs_and_output_bag(bags, serial):
 
 def test_batch_of_three_bags_equals_serial_bag_runner(bags, serial):
     out = os.path.join(SCRATCH, "batch")
-    result = batch("--out", out, os.path.join(SCRATCH, "drive*.bag"))
+    result = batch("--out", out, os.path.join(SCRATCH, "drive?.bag"))
     assert result.returncode == 0, result.stderr
     for name, folder in serial.items():
         assert pngs(os.path.join(out, name)) == pngs(folder), name
@@ -286,9 +254,8 @@ def test_zed_velodyne_topics_with_late_sweeps(bags, serial):
 
 
 def test_node_params_file_and_approximate_sync(bags):
-    source = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
     outputs = []
-    for i, extra in enumerate(([], ["--node-params", os.path.join(source, "config",
+    for i, extra in enumerate(([], ["--node-params", os.path.join(SOURCE, "config",
                                                                     "fusion_node.yaml")],
                                ["--approximate-sync"])):
         folder = os.path.join(SCRATCH, "node_params%d" % i)

@@ -13,9 +13,7 @@ The bags are written at test time into LSF_SCRATCH (the build folder). Missing d
 CI=true and skips otherwise. Waits are on conditions with deadlines; nothing is timed."""
 
 import os
-import shutil
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -24,17 +22,12 @@ import time
 import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import batch_bags  # noqa: E402
+import bag_tool_setup  # noqa: E402
 import recording_bags  # noqa: E402
-from test_recordings import (JPEG_PRIOR_BEYOND_1PX, JPEG_PRIOR_MEAN,  # noqa: E402
-                             JPEG_SURE_WITHIN_1PX, JPEG_VALIDITY)
+from bag_tool_setup import (BAG_RUNNER, DEADLINE, FB, FUSION_NODE,  # noqa: E402
+                            JPEG_PRIOR_BEYOND_1PX, JPEG_PRIOR_MEAN, JPEG_SURE_WITHIN_1PX,
+                            JPEG_VALIDITY, SCRATCH, SOURCE, free_port, run)
 
-SOURCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
-BIN = os.environ.get("LSF_BIN_DIR", "")
-DATA = os.environ.get("LSF_DATA_DIR", "")
-SCRATCH = os.environ.get("LSF_SCRATCH", "/tmp/lsf_recordings_node_test")
-DEADLINE = 300  # [s] for a launch to give what a test waits for
-FB = 721.5377 * 0.5327  # [px m] fx * baseline of the KITTI sample (drive 0009)
 TOPICS = {"left_image": "/stereo/left/image_rect_color", "left_info": "/stereo/left/camera_info",
           "right_image": "/stereo/right/image_rect_color",
           "right_info": "/stereo/right/camera_info"}
@@ -42,20 +35,8 @@ TOPICS = {"left_image": "/stereo/left/image_rect_color", "left_info": "/stereo/l
 _master = {}
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def setup_module():
-    if not os.path.isdir(os.path.join(DATA, batch_bags.DATE, batch_bags.DRIVE)):
-        message = "KITTI sample drive missing under LSF_DATA_DIR=%r" % DATA
-        if os.environ.get("CI") == "true":
-            pytest.fail(message)
-        pytest.skip(message, allow_module_level=True)
-    shutil.rmtree(SCRATCH, ignore_errors=True)
-    os.makedirs(SCRATCH)
+    bag_tool_setup.prepare()
     port = free_port()
     os.environ["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % port
     os.environ["ROS_HOME"] = os.path.join(SCRATCH, "ros_home")
@@ -189,8 +170,8 @@ class Depths:
 
 @pytest.fixture(scope="module")
 def drive():
-    return batch_bags.kitti_bag(os.path.join(BIN, "kitti_to_bag"), DATA, SCRATCH,
-                                ["0000000000", "0000000005"], os.path.join(SCRATCH, "drive.bag"))
+    """Two KITTI frames (0.52 s apart), raw images."""
+    return bag_tool_setup.drive_bag()
 
 
 @pytest.fixture(scope="module")
@@ -198,11 +179,9 @@ def reference(drive):
     """bag_runner on the raw bag with the node's configuration: {PNG name: uint16 depth}."""
     import cv2
     out = os.path.join(SCRATCH, "reference")
-    result = subprocess.run([os.path.join(BIN, "bag_runner"), "--bag", drive, "--out", out,
-                             "--params", os.path.join(SOURCE, "config", "fusion.yaml"),
-                             "--node-params", os.path.join(SOURCE, "config", "fusion_node.yaml")],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            universal_newlines=True)
+    result = run([BAG_RUNNER, "--bag", drive, "--out", out,
+                  "--params", os.path.join(SOURCE, "config", "fusion.yaml"),
+                  "--node-params", os.path.join(SOURCE, "config", "fusion_node.yaml")])
     assert result.returncode == 0, result.stderr
     return {n: cv2.imread(os.path.join(out, n), cv2.IMREAD_UNCHANGED)
             for n in os.listdir(out) if n.endswith(".png")}
@@ -252,8 +231,7 @@ def test_node_compressed_jpeg_is_within_the_stated_tolerance(drive, reference):
 
 def fusion_node(log_name, *args):
     """fusion_node in /fusion, with `args` (remaps, _private:=value)."""
-    return Launch([os.path.join(BIN, "fusion_node"), "__ns:=/fusion", "__name:=fusion"] +
-                  list(args), log_name)
+    return Launch([FUSION_NODE, "__ns:=/fusion", "__name:=fusion"] + list(args), log_name)
 
 
 @pytest.mark.parametrize("transport,topic", [

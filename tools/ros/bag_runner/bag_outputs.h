@@ -11,9 +11,9 @@
 #include <rosbag/bag.h>
 #include <Eigen/Geometry>
 
+#include "bag_pairing.h"
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
-#include "lidar_stereo_fusion/ros/bag_pairing.h"
 #include "lidar_stereo_fusion/ros/frame_input.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 

@@ -12,12 +12,12 @@
 
 #include <rosbag/bag.h>
 
+#include "bag_inputs.h"
+#include "bag_manifest.h"
+#include "bag_outputs.h"
+#include "bag_pairing.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
-#include "lidar_stereo_fusion/io/report.h"
-#include "lidar_stereo_fusion/ros/bag_inputs.h"
-#include "lidar_stereo_fusion/ros/bag_manifest.h"
-#include "lidar_stereo_fusion/ros/bag_outputs.h"
-#include "lidar_stereo_fusion/ros/bag_pairing.h"
+#include "lidar_stereo_fusion/io/progress.h"
 
 namespace lidar_stereo_fusion {
 

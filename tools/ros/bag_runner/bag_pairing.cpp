@@ -1,4 +1,4 @@
-#include "lidar_stereo_fusion/ros/bag_pairing.h"
+#include "bag_pairing.h"
 
 #include <cinttypes>
 #include <cstdio>

@@ -11,7 +11,7 @@
 
 #include <rosbag/bag.h>
 
-#include "lidar_stereo_fusion/ros/bag_pairing.h"
+#include "bag_pairing.h"
 
 namespace lidar_stereo_fusion {
 

@@ -15,8 +15,8 @@
 #include <utility>
 #include <vector>
 
+#include "bag_pairing.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
-#include "lidar_stereo_fusion/ros/bag_pairing.h"
 #include "lidar_stereo_fusion/ros/node_params.h"
 
 namespace lidar_stereo_fusion {

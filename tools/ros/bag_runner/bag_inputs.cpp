@@ -1,4 +1,4 @@
-#include "lidar_stereo_fusion/ros/bag_inputs.h"
+#include "bag_inputs.h"
 
 #include <algorithm>
 #include <cerrno>

@@ -1,4 +1,4 @@
-#include "lidar_stereo_fusion/ros/bag_outputs.h"
+#include "bag_outputs.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,9 +8,9 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "bag_files.h"
 #include "lidar_stereo_fusion/core/depth.h"
 #include "lidar_stereo_fusion/io/pcd.h"
-#include "lidar_stereo_fusion/ros/bag_files.h"
 #include "lidar_stereo_fusion/ros/conversions.h"
 #include "lidar_stereo_fusion/ros/frame_input.h"
 #include "lidar_stereo_fusion/ros/output_publisher.h"

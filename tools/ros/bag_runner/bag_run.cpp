@@ -1,4 +1,4 @@
-#include "lidar_stereo_fusion/ros/bag_run.h"
+#include "bag_run.h"
 
 #include <unistd.h>
 
@@ -12,9 +12,9 @@
 #include <tf2/exceptions.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include "bag_files.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
-#include "lidar_stereo_fusion/io/report.h"
-#include "lidar_stereo_fusion/ros/bag_files.h"
+#include "lidar_stereo_fusion/io/progress.h"
 #include "lidar_stereo_fusion/ros/ego_motion.h"
 
 namespace fs = std::filesystem;

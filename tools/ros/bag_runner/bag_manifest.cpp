@@ -1,4 +1,4 @@
-#include "lidar_stereo_fusion/ros/bag_manifest.h"
+#include "bag_manifest.h"
 
 #include <sys/stat.h>
 

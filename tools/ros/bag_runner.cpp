@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "bag_runner/bag_run.h"
 #include "lidar_stereo_fusion/io/cli.h"
-#include "lidar_stereo_fusion/ros/bag_run.h"
 
 namespace lsf = lidar_stereo_fusion;
 namespace fs = std::filesystem;

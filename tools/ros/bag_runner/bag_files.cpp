@@ -1,4 +1,4 @@
-#include "lidar_stereo_fusion/ros/bag_files.h"
+#include "bag_files.h"
 
 #include <signal.h>
 #include <unistd.h>
