@@ -39,34 +39,6 @@ float intervalResidual(const ColumnEntry* e, int n, int k, float max_slope) {
   return r;
 }
 
-/// Every interval's agreement (prior_confidence.h), column by column, stored at its upper line's
-/// entry; NaN where the interval is not bridged (adjacent lines, or no prior between them).
-std::vector<std::vector<float>> intervalAgreement(const ColumnIndex& index, const cv::Mat1f& prior,
-                                                  const std::vector<std::vector<int>>& removed_rows,
-                                                  const PriorConfidenceParams& params) {
-  const float tolerance = static_cast<float>(params.edge_tolerance);
-  const float inv_sigma = static_cast<float>(1.0 / params.edge_sigma);
-  const float max_slope = static_cast<float>(params.max_surface_slope);
-  const float removed_factor = static_cast<float>(params.removed_factor);
-  std::vector<std::vector<float>> agreement(index.cols());
-  for (int x = 0; x < index.cols(); ++x) {
-    const ColumnEntry* e = index.column(x);
-    const int n = index.size(x);
-    const std::vector<int>& gone = removed_rows[x];
-    agreement[x].assign(n, std::nanf(""));
-    for (int k = 0; k + 1 < n; ++k) {
-      const int y_up = e[k].y, y_down = e[k + 1].y;
-      if (y_down - y_up < 2 || !(prior(y_up + 1, x) > 0.f)) continue;  // adjacent, or not bridged
-      const float r = intervalResidual(e, n, k, max_slope);
-      float agree = std::exp(-std::max(0.f, r - tolerance) * inv_sigma);
-      const auto it = std::upper_bound(gone.begin(), gone.end(), y_up);
-      if (it != gone.end() && *it < y_down) agree *= removed_factor;
-      agreement[x][k] = agree;
-    }
-  }
-  return agreement;
-}
-
 }  // namespace
 
 void PriorConfidenceParams::validate() const { requireRanges("PriorConfidenceParams", *this); }
@@ -89,33 +61,33 @@ cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
   }
   for (auto& r : removed_rows) std::sort(r.begin(), r.end());
 
+  const float tolerance = static_cast<float>(params.edge_tolerance);
+  const float inv_sigma = static_cast<float>(1.0 / params.edge_sigma);
+  const float max_slope = static_cast<float>(params.max_surface_slope);
   const float near_rows = static_cast<float>(params.near_rows);
   const float inv_decay = params.decay_rows > 0 ? static_cast<float>(1.0 / params.decay_rows) : 0.f;
-  const ColumnIndex index(lines.disparity);
-  const std::vector<std::vector<float>> agreement =
-      intervalAgreement(index, prior, removed_rows, params);
-  // Pass 2, row by row (the map is row-major; written column by column it took 3 ms a KITTI view
-  // against 1), each column keeping its place among its lines.
+  const float removed_factor = static_cast<float>(params.removed_factor);
+
   cv::Mat1f confidence = cv::Mat1f::zeros(prior.size());
-  std::vector<int> last(cols, -1);  // per column: the last line at or above row y
-  for (int y = 0; y < rows; ++y) {
-    const float* prior_row = prior[y];
-    float* out = confidence[y];
-    for (int x = 0; x < cols; ++x) {
-      const int n = index.size(x);
-      if (n == 0) continue;
-      const ColumnEntry* e = index.column(x);
-      int& k = last[x];
-      while (k + 1 < n && e[k + 1].y <= y) ++k;
-      if (k < 0 || !(prior_row[x] > 0.f)) continue;
-      if (e[k].y == y) {
-        out[x] = 1.f;  // a scan-line pixel
-        continue;
+  const ColumnIndex index(lines.disparity);
+  for (int x = 0; x < cols; ++x) {
+    const ColumnEntry* e = index.column(x);
+    const int n = index.size(x);
+    const std::vector<int>& gone = removed_rows[x];
+    for (int k = 0; k < n; ++k) {
+      if (prior(e[k].y, x) > 0.f) confidence(e[k].y, x) = 1.f;
+      if (k + 1 == n) break;
+      const int y_up = e[k].y, y_down = e[k + 1].y;
+      if (y_down - y_up < 2 || !(prior(y_up + 1, x) > 0.f)) continue;  // adjacent, or not bridged
+      const float r = intervalResidual(e, n, k, max_slope);
+      float agree = std::exp(-std::max(0.f, r - tolerance) * inv_sigma);
+      const auto it = std::upper_bound(gone.begin(), gone.end(), y_up);
+      if (it != gone.end() && *it < y_down) agree *= removed_factor;
+      for (int y = y_up + 1; y < y_down; ++y) {
+        const float dist = static_cast<float>(std::min(y - y_up, y_down - y));
+        const float near = std::exp(-std::max(0.f, dist - near_rows) * inv_decay);
+        if (prior(y, x) > 0.f) confidence(y, x) = agree * near;
       }
-      if (k + 1 == n || std::isnan(agreement[x][k])) continue;
-      const float dist = static_cast<float>(std::min(y - e[k].y, e[k + 1].y - y));
-      const float near = std::exp(-std::max(0.f, dist - near_rows) * inv_decay);
-      out[x] = agreement[x][k] * near;
     }
   }
   return confidence;

@@ -230,29 +230,21 @@ ScanLineBounds computeScanLineBounds(const ScanLines& lines, double margin_px) {
   bounds.lo = cv::Mat1f::zeros(lines.disparity.size());
   bounds.hi = cv::Mat1f::zeros(lines.disparity.size());
   bounds.range = cv::Mat1f::zeros(lines.disparity.size());
-  // Row by row (the maps are row-major; a column walk wrote them with a stride of a row and
-  // took 5.5 ms a view on KITTI against 0.5), each column keeping its place among its lines.
-  // For row y, "up" is the nearest line strictly above y and "down" the nearest strictly below.
-  const int cols = index.cols();
-  std::vector<int> next(cols, 0);  // per column: index of the first line with row > y
-  for (int y = 0; y < lines.disparity.rows; ++y) {
-    float* lo = bounds.lo[y];
-    float* hi = bounds.hi[y];
-    float* range = bounds.range[y];
-    for (int x = 0; x < cols; ++x) {
-      const int n = index.size(x);
-      if (n < 2) continue;
-      const ColumnEntry* entries = index.column(x);
-      int& k = next[x];
-      while (k < n && entries[k].y <= y) ++k;
-      if (y <= entries[0].y || y >= entries[n - 1].y) continue;
-      const int up_index = entries[k - 1].y == y ? k - 2 : k - 1;
-      if (up_index < 0 || k >= n) continue;
+  for (int x = 0; x < index.cols(); ++x) {
+    const ColumnEntry* entries = index.column(x);
+    const int n = index.size(x);
+    if (n < 2) continue;
+    // For row y, "up" is the nearest line strictly above y and "down" the nearest strictly below.
+    int next = 0;  // index of the first line with row > y
+    for (int y = entries[0].y + 1; y < entries[n - 1].y; ++y) {
+      while (next < n && entries[next].y <= y) ++next;
+      const int up_index = entries[next - 1].y == y ? next - 2 : next - 1;
+      if (up_index < 0 || next >= n) continue;
       const float d_up = entries[up_index].d;
-      const float d_down = entries[k].d;
-      lo[x] = static_cast<float>(std::min(d_up, d_down) - margin_px);
-      hi[x] = static_cast<float>(std::max(d_up, d_down) + margin_px);
-      range[x] = std::abs(d_up - d_down);
+      const float d_down = entries[next].d;
+      bounds.lo(y, x) = static_cast<float>(std::min(d_up, d_down) - margin_px);
+      bounds.hi(y, x) = static_cast<float>(std::max(d_up, d_down) + margin_px);
+      bounds.range(y, x) = std::abs(d_up - d_down);
     }
   }
   return bounds;
