@@ -52,7 +52,7 @@ Options:
   --ip-basic-blur <b>   IP-Basic's last blur: gaussian (the paper's, default), bilateral, none
   --reference <rule>    dense: how the sweeps' points of a pixel make its reference depth:
                         nearest (a z-buffer, default) or majority (the depth most sweeps agree
-                        on; see doc/accuracy.md, the reference's foreground bias)
+                        on; see doc/accuracy.md, who is right at depth edges)
   --help                this text
 )";
 

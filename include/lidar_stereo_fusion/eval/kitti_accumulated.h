@@ -39,8 +39,8 @@ struct AccumulationParams {
   /// the nearest. kMajority: each sweep's nearest point in the pixel is one vote; the depth most
   /// sweeps agree on (the largest group within `tolerance` of its nearest member; between equal
   /// groups the nearer) wins, as the group's median. Near a depth edge the sweeps' points scatter
-  /// by a pixel or so (poses, rounding), and the nearest of up to 11 then widens every foreground
-  /// object (doc/accuracy.md, "the reference's foreground bias").
+  /// by a pixel or so (poses, rounding), and the nearest of up to 11 favours the foreground there
+  /// (doc/accuracy.md, "who is right at depth edges").
   enum class Combine { kNearest, kMajority };
   Combine combine = Combine::kNearest;
   /// Throws std::invalid_argument naming the first impossible value.
