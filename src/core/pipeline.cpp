@@ -7,6 +7,7 @@
 
 #include "lidar_stereo_fusion/core/both_views.h"
 #include "lidar_stereo_fusion/core/motion_compensation.h"
+#include "lidar_stereo_fusion/core/output_median.h"
 
 namespace lidar_stereo_fusion {
 
@@ -122,7 +123,8 @@ PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
   base.window_dyadic = false;
   base.window_round = false;
   base.median_radius = 17;
-  base.iterations = 3;  // Bleyer's
+  base.output_median = 0;  // not Bleyer's
+  base.iterations = 3;     // Bleyer's
   base.right_iterations = -1;
   base.init_from_prior = false;
   base.use_lidar_bounds = false;
@@ -259,6 +261,9 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
     }
     PatchMatchResult matched = patchmatch_.compute(left, right);
     result.disparity = matched.disparity;
+    if (fused && params_.patchmatch.output_median > 0) {
+      result.disparity = medianOfValues(result.disparity, params_.patchmatch.output_median);
+    }
     stats.patchmatch_steps = std::move(matched.steps);
   } else {
     result.disparity = result.prior.clone();

@@ -36,6 +36,8 @@ void PatchMatchParams::validate() const {
   require(std::abs(alpha + beta + gamma - 1.0) < 1e-6, "alpha + beta + gamma must be 1");
   require(!confidence_weighting || alpha + beta > 0,
           "confidence_weighting needs an image term (alpha + beta > 0)");
+  require(output_median == 0 || output_median == 3 || output_median == 5,
+          "output_median must be 0, 3 or 5, got " + std::to_string(output_median));
   require(right_iterations != 0, "right_iterations must be -1 (every iteration) or >= 1, got 0");
   require(max_disparity > min_disparity, "max_disparity must be > min_disparity");
   require(isLevelScale(*this, search_scale),

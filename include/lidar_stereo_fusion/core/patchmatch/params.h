@@ -78,6 +78,8 @@ struct PatchMatchParams {
   /// PMS uses its matching window (Bleyer); the fused method 11x11, which was as accurate as its
   /// 17x17 matching window on every protocol and cheaper.
   int median_radius = 5;
+  /// Median of the fused output over size x size pixels (3 or 5; 0 = none): output_median.h.
+  int output_median = 3;
   /// Weight the LiDAR term by the prior's confidence and renormalise the image term where it fades
   /// (patchmatch/cost.h); false = the paper's cost (gamma everywhere the prior has a value).
   bool confidence_weighting = true;
