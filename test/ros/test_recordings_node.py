@@ -266,8 +266,10 @@ def test_node_a_swapped_pair_is_warned_once_naming_the_fix(drive):
         with depths.lock:
             seen = set(depths.depth)
             depths.depth.clear()
-        # Another loop of the bag: more image sets, still one warning.
-        assert wait_for(lambda: set(depths.depth) >= seen or not launch.running()), launch.log
+        # Another loop of the bag (a stamp of the first pass again; under load the node may drop
+        # any one image set, so not all of them): more image sets, still one warning.
+        assert wait_for(lambda: set(depths.depth) & seen or not launch.running()), launch.log
+        assert launch.running(), launch.log
         said = launch.containing("looks swapped")
         assert len(said) == 1, said
         assert ("left/image_rect_color:=" + TOPICS["left_image"] + " right/image_rect_color:=" +
