@@ -190,14 +190,22 @@ TEST(KittiRunner, AnOutputFolderAmongItsInputsIsRefused) {
   const fs::path first = *fs::directory_iterator(images);
   const std::string before = fileBytes(first);
   const size_t files = std::distance(fs::directory_iterator(images), fs::directory_iterator());
-  for (const fs::path& out : {images, drive.drive(), drive.drive() / "new" / "depth"}) {
-    const RunResult r = drive.run("--out " + out.string() + " --method lidar_bi --frames 1");
+  for (const std::string& out : {images.string(), images.string() + "/", drive.drive().string(),
+                                 (drive.drive() / "new" / "depth").string()}) {
+    const RunResult r = drive.run("--out " + out + " --method lidar_bi --frames 1");
     EXPECT_EQ(r.status, 1) << out;
     EXPECT_NE(r.err.find("is inside the drive (--kitti-raw)"), std::string::npos) << r.err;
   }
   EXPECT_EQ(fileBytes(first), before);
   EXPECT_EQ(std::distance(fs::directory_iterator(images), fs::directory_iterator()), files);
   EXPECT_FALSE(fs::exists(drive.drive() / "new"));
+  // the drive named with a trailing separator is the same drive
+  const RunResult slash =
+      test::runCommand(runnerPath() + " --kitti-raw " + drive.drive().string() + "/ --out " +
+                           images.string() + " --method lidar_bi --frames 1",
+                       drive.outDir().parent_path());
+  EXPECT_EQ(slash.status, 1) << slash.err;
+  EXPECT_NE(slash.err.find("is inside the drive (--kitti-raw)"), std::string::npos) << slash.err;
   // a symbolic link to the drive is the drive
   const fs::path link = drive.outDir().parent_path() / "drive_link";
   fs::create_directory_symlink(drive.drive(), link);

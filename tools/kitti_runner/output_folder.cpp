@@ -36,11 +36,22 @@ void createDirectory(const fs::path& dir) {
   }
 }
 
+namespace {
+
+/// `path` absolute, symbolic links resolved, without a trailing separator ("a/b/" -> "a/b").
+fs::path resolved(const fs::path& path, std::error_code& error) {
+  fs::path p = fs::weakly_canonical(fs::absolute(path), error);
+  if (!p.has_filename() && p != p.root_path()) p = p.parent_path();
+  return p;
+}
+
+}  // namespace
+
 void requireApart(const fs::path& out, const fs::path& input, const std::string& what) {
-  std::error_code error;
-  const fs::path inner = fs::weakly_canonical(fs::absolute(out), error);
-  const fs::path outer = fs::weakly_canonical(fs::absolute(input), error);
-  if (error) return;  // the input's own check names it
+  std::error_code out_error, input_error;
+  const fs::path inner = resolved(out, out_error);
+  const fs::path outer = resolved(input, input_error);
+  if (out_error || input_error) return;  // the folders' own checks name them
   for (fs::path p = inner; !p.empty(); p = p.parent_path()) {
     if (p == outer) {
       throw std::runtime_error("output folder " + out.string() + " is inside " + what + " " +
