@@ -81,6 +81,20 @@ def long_bag():
     return kitti_bag("long", THREE_FRAMES, ["--period", "0.1", "--cycles", "3"])
 
 
+# The bags as module-scope pytest fixtures `drive` and `long_bag`; a test module imports them
+# (from bag_tool_setup import drive_fixture, long_bag_fixture) instead of declaring its own.
+@pytest.fixture(scope="module", name="drive")
+def drive_fixture():
+    """Two KITTI frames (0.52 s apart), raw images."""
+    return drive_bag()
+
+
+@pytest.fixture(scope="module", name="long_bag")
+def long_bag_fixture():
+    """3 frames restamped at 10 Hz, 3 times: 9 image sets over 0.9 s."""
+    return long_bag()
+
+
 def run(command, **kwargs):
     """`command` (any items, made strings) with its output captured, one OpenMP thread, and the
     deadline unless `timeout` is given."""

@@ -24,6 +24,7 @@ import pytest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import batch_bags  # noqa: E402
 import bag_tool_setup  # noqa: E402
+from bag_tool_setup import long_bag_fixture  # noqa: E402,F401 (pytest fixtures)
 from bag_tool_setup import (BAG_RUNNER, DEADLINE, LSF_BATCH, SCRATCH, SOURCE,  # noqa: E402
                             batch, run)
 
@@ -63,12 +64,6 @@ def serial(bags):
         assert result.returncode == 0, result.stderr
         out[name] = folder
     return out
-
-
-@pytest.fixture(scope="module")
-def long_bag():
-    """3 frames restamped at 10 Hz, 3 times: 9 image sets over 0.9 s."""
-    return bag_tool_setup.long_bag()
 
 
 def test_bag_runner_writes_a_named_png_and_row_per_set(bags, serial):

@@ -21,6 +21,7 @@ import pytest
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import batch_bags  # noqa: E402
 import bag_tool_setup  # noqa: E402
+from bag_tool_setup import drive_fixture, long_bag_fixture  # noqa: E402,F401 (pytest fixtures)
 import recording_bags  # noqa: E402
 from bag_tool_setup import (FB, JPEG_PRIOR_BEYOND_1PX, JPEG_PRIOR_MEAN,  # noqa: E402
                             JPEG_SURE_WITHIN_1PX, JPEG_VALIDITY, LAUNCH_DIR, SCRATCH, bag_runner,
@@ -34,18 +35,6 @@ SWAP_REMAPS = ["left/image_rect_color:=/stereo/right/image_rect_color",
 
 def setup_module():
     bag_tool_setup.prepare()
-
-
-@pytest.fixture(scope="module")
-def drive():
-    """Two KITTI frames (0.52 s apart), raw images."""
-    return bag_tool_setup.drive_bag()
-
-
-@pytest.fixture(scope="module")
-def long_bag():
-    """3 frames restamped at 10 Hz, 3 times: 9 image sets over 0.9 s."""
-    return bag_tool_setup.long_bag()
 
 
 @pytest.fixture(scope="module")

@@ -23,6 +23,7 @@ import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bag_tool_setup  # noqa: E402
+from bag_tool_setup import drive_fixture  # noqa: E402,F401 (pytest fixtures)
 import recording_bags  # noqa: E402
 from bag_tool_setup import (BAG_RUNNER, DEADLINE, FB, FUSION_NODE,  # noqa: E402
                             JPEG_PRIOR_BEYOND_1PX, JPEG_PRIOR_MEAN, JPEG_SURE_WITHIN_1PX,
@@ -166,12 +167,6 @@ class Depths:
     def close(self):
         for s in self.subs:
             s.unregister()
-
-
-@pytest.fixture(scope="module")
-def drive():
-    """Two KITTI frames (0.52 s apart), raw images."""
-    return bag_tool_setup.drive_bag()
 
 
 @pytest.fixture(scope="module")

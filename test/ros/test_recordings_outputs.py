@@ -26,6 +26,7 @@ import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import bag_tool_setup  # noqa: E402
+from bag_tool_setup import drive_fixture, long_bag_fixture  # noqa: E402,F401 (pytest fixtures)
 import recording_bags  # noqa: E402
 from bag_tool_setup import (BAG_RUNNER, DEADLINE, SCRATCH, bag_runner, batch,  # noqa: E402
                             digest, pngs, run, scratch)
@@ -39,18 +40,6 @@ def stamp_png(name):
     stem = name[:-4] if name.endswith(".png") else ""
     sec, _, nsec = stem.partition(".")
     return sec.isdigit() and nsec.isdigit() and len(nsec) == 9
-
-
-@pytest.fixture(scope="module")
-def drive():
-    """Two KITTI frames (0.52 s apart), raw images."""
-    return bag_tool_setup.drive_bag()
-
-
-@pytest.fixture(scope="module")
-def long_bag():
-    """3 frames restamped at 10 Hz, 3 times: 9 image sets over 0.9 s."""
-    return bag_tool_setup.long_bag()
 
 
 # Row 1 ------------------------------------------------------------------------------------------
