@@ -53,11 +53,15 @@ Options:
   --reference <rule>    dense: how the sweeps' points of a pixel make its reference depth:
                         nearest (a z-buffer, default) or majority (the depth most sweeps agree
                         on; see doc/accuracy.md, who is right at depth edges)
+  --stereo-check <px>   dense: keep only the reference pixels where OpenCV's SGBM (the
+                        benchmark's) has a disparity within <px> of the reference's, as KITTI's
+                        ground truth is cleaned with stereo (0 = off, default; e.g. 3)
   --help                this text
 )";
 
 struct Options {
   std::string data, params, ip_basic_blur = "gaussian", reference = "nearest";
+  double stereo_check_px = 0.0;
   std::set<std::string> methods, layouts;
   bool middlebury = true, kitti = true, dense = true, kitti_pms = true;
   int frames = 0;
@@ -88,7 +92,7 @@ std::string defaultDataDir() {
 Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(argc, argv,
                             {"--data", "--protocols", "--layouts", "--frames", "--params",
-                             "--methods", "--ip-basic-blur", "--reference"},
+                             "--methods", "--ip-basic-blur", "--reference", "--stereo-check"},
                             {"--no-kitti-pms"});
   Options o;
   o.data = cl.value("--data", defaultDataDir());
@@ -97,6 +101,7 @@ Options parseOptions(int argc, char** argv) {
   o.params = cl.value("--params", "");
   o.ip_basic_blur = cl.choice("--ip-basic-blur", "gaussian", {"gaussian", "bilateral", "none"});
   o.reference = cl.choice("--reference", "nearest", {"nearest", "majority"});
+  o.stereo_check_px = cl.doubleValue("--stereo-check", 0.0, 0.0, 1000.0);
   if (cl.has("--methods")) o.methods = splitList(cl.value("--methods"));
   if (cl.has("--layouts")) o.layouts = splitList(cl.value("--layouts"));
   for (const std::string& layout : o.layouts) {
@@ -185,19 +190,22 @@ void printKitti(const lsf::AccuracyOptions& options) {
             << (options.kitti_pms ? "" : " (without pms)") << "\n\n";
 }
 
-void printDense(const lsf::AccuracyOptions& options, const std::string& reference) {
+void printDense(const lsf::AccuracyOptions& options, const std::string& reference,
+                double stereo_check_px) {
   const auto t = std::chrono::steady_clock::now();
   lsf::kitti::AccumulationParams reference_params;
   if (reference == "majority") {
     reference_params.combine = lsf::kitti::AccumulationParams::Combine::kMajority;
   }
-  const lsf::DenseProtocolResult dense = lsf::runDenseProtocol(options, reference_params);
+  const lsf::DenseProtocolResult dense =
+      lsf::runDenseProtocol(options, reference_params, stereo_check_px);
   std::cout << "## dense: " << dense.layout.description << "\n\n"
             << lsf::formatKittiLayout(dense.layout)
             << "\nPer depth band of the reference depth:\n\n"
             << lsf::formatDepthBands(dense.layout) << "\nPer region:\n\n"
             << lsf::formatKittiRegions(dense.layout) << "\nThe reference:\n\n"
-            << lsf::formatAccumulatedReference(dense.reference) << "\n";
+            << lsf::formatAccumulatedReference(dense.reference)
+            << lsf::formatStereoCheck(dense.stereo_check, stereo_check_px) << "\n";
   std::cout << "Dense protocol: " << secondsSince(t) << " s"
             << (options.kitti_pms ? "" : " (without pms)") << "\n";
 }
@@ -213,7 +221,7 @@ int run(const Options& o) {
                "the fill. Regions: see eval/accuracy_protocols.h.\n\n";
   if (o.middlebury) printMiddlebury(options);
   if (o.kitti) printKitti(options);
-  if (o.dense) printDense(options, o.reference);
+  if (o.dense) printDense(options, o.reference, o.stereo_check_px);
   return 0;
 }
 

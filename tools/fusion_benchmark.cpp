@@ -23,6 +23,7 @@
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/core/upsampling.h"
 #include "lidar_stereo_fusion/eval/report.h"
+#include "lidar_stereo_fusion/eval/stereo_check.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
@@ -243,8 +244,7 @@ int run(const Options& o) {
       lsf::simdPathName(params.patchmatch.simd_path), o.repeat);
   cv::Ptr<cv::StereoSGBM> sgbm;
   if (o.sgbm) {
-    sgbm = cv::StereoSGBM::create(0, 128, 5, 8 * 3 * 25, 32 * 3 * 25, 1, 63, 10, 100, 32,
-                                  cv::StereoSGBM::MODE_SGBM_3WAY);
+    sgbm = lsf::referenceSgbm();
   }
   lsf::FusionPipeline pipeline(params);
   if (cases.size() == 1) {

@@ -8,12 +8,15 @@
 #include <stdexcept>
 
 #include "accuracy_common.h"
+#include "lidar_stereo_fusion/eval/report.h"
 
 namespace lidar_stereo_fusion {
 
 DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
-                                     const kitti::AccumulationParams& reference_params) {
+                                     const kitti::AccumulationParams& reference_params,
+                                     double stereo_check_px) {
   using namespace accuracy_detail;
+  using table::format;
   options.validate();
   const std::string drive =
       (std::filesystem::path(options.data_dir) / "kitti_raw/2011_09_26/2011_09_26_drive_0009_sync")
@@ -33,6 +36,12 @@ DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
   DenseProtocolResult out;
   out.reference = kitti::buildAccumulatedReference(drive, kDenseFrame, calib, reference_params);
   const kitti::FrameData data = kitti::loadFrame(*frame, calib.camera);
+  if (stereo_check_px > 0.0) {
+    out.stereo_check = removeStereoOutliers(
+        out.reference.depth, sgbmDisparity(data.left, data.right), calib.camera, stereo_check_px);
+    out.reference.pixels = cv::countNonZero(out.reference.depth);
+    out.reference.own_pixels = cv::countNonZero(out.reference.own & (out.reference.depth > 0.f));
+  }
   LayoutScores<DepthMetrics>& layout = out.layout;
   layout.name = "dense";
   layout.items.push_back(frame->name);
@@ -45,16 +54,19 @@ DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
                  pipelineRows(options, options.kitti_pms), pms, acc);
   layout.methods = acc.finish();
   const long center = static_cast<long>(kitti::frameIndex(kDenseFrame));
-  layout.description = "KITTI drive 0009 frame " + std::to_string(center) + ", the full sweep (" +
-                       std::to_string(rings.size()) +
-                       " rings) fed, scored against the depth accumulated from sweeps " +
-                       std::to_string(center - reference_params.half_span) + "-" +
-                       std::to_string(center + reference_params.half_span) + " (" +
-                       std::to_string(out.reference.pixels) +
-                       " pixels, the frame's own sweep included; " +
-                       (reference_params.combine == kitti::AccumulationParams::Combine::kMajority
-                            ? "per pixel the depth most sweeps agree on)"
-                            : "per pixel the nearest point)");
+  layout.description =
+      "KITTI drive 0009 frame " + std::to_string(center) + ", the full sweep (" +
+      std::to_string(rings.size()) +
+      " rings) fed, scored against the depth accumulated from sweeps " +
+      std::to_string(center - reference_params.half_span) + "-" +
+      std::to_string(center + reference_params.half_span) + " (" +
+      std::to_string(out.reference.pixels) + " pixels, the frame's own sweep included; " +
+      (reference_params.combine == kitti::AccumulationParams::Combine::kMajority
+           ? "per pixel the depth most sweeps agree on)"
+           : "per pixel the nearest point)") +
+      (stereo_check_px > 0.0
+           ? ", kept where SGBM agrees within " + format("%g", stereo_check_px) + " px"
+           : std::string());
   return out;
 }
 

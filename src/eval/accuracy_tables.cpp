@@ -145,4 +145,16 @@ std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference)
   return out;
 }
 
+std::string formatStereoCheck(const StereoCheckCounts& counts, double max_diff_px) {
+  if (!(max_diff_px > 0.0)) return "";
+  const auto share = [&](int n) {
+    return std::to_string(n) + " (" + format("%.1f", 100.0 * n / std::max(1, counts.checked)) +
+           " %)";
+  };
+  return row({"stereo check: reference pixels checked", std::to_string(counts.checked)}) +
+         row({"removed: SGBM has no disparity there", share(counts.removed_no_stereo)}) +
+         row({"removed: SGBM differs by more than " + format("%g", max_diff_px) + " px",
+              share(counts.removed_disagreeing)});
+}
+
 }  // namespace lidar_stereo_fusion

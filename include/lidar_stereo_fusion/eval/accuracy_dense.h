@@ -10,6 +10,7 @@
 
 #include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 #include "lidar_stereo_fusion/eval/kitti_accumulated.h"
+#include "lidar_stereo_fusion/eval/stereo_check.h"
 
 namespace lidar_stereo_fusion {
 
@@ -19,14 +20,18 @@ constexpr const char* kDenseFrame = "0000000020";
 /// The layout "dense" and how its reference was built.
 struct DenseProtocolResult {
   LayoutScores<DepthMetrics> layout;
-  kitti::AccumulatedDepth reference;
+  kitti::AccumulatedDepth reference;  ///< after the stereo check, if one ran
+  StereoCheckCounts stereo_check;     ///< all 0 without one
 };
 
 /// Runs the dense protocol on data_dir/kitti_raw/2011_09_26/2011_09_26_drive_0009_sync (every
 /// wanted row; pms and "lidar_bi else pms" only when options.kitti_pms). Throws
 /// std::runtime_error naming what is missing (the drive, a sweep, an OXTS packet, the frame's
-/// images).
+/// images). With stereo_check_px > 0 the reference keeps only the pixels where SGBM of the
+/// frame's pair agrees within that many pixels (removeStereoOutliers; KITTI's ground truth is
+/// cleaned with stereo likewise).
 DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
-                                     const kitti::AccumulationParams& reference_params = {});
+                                     const kitti::AccumulationParams& reference_params = {},
+                                     double stereo_check_px = 0.0);
 
 }  // namespace lidar_stereo_fusion

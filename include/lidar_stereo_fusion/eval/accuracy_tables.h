@@ -6,6 +6,7 @@
 
 #include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 #include "lidar_stereo_fusion/eval/kitti_accumulated.h"
+#include "lidar_stereo_fusion/eval/stereo_check.h"
 
 namespace lidar_stereo_fusion {
 
@@ -32,5 +33,9 @@ std::string formatDepthBands(const LayoutScores<DepthMetrics>& layout);
 
 /// How an accumulated reference was built (eval/kitti_accumulated.h), as a two-column table.
 std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference);
+
+/// The stereo check's rows, to follow formatAccumulatedReference's table (empty when max_diff_px
+/// is 0: no check ran).
+std::string formatStereoCheck(const StereoCheckCounts& counts, double max_diff_px);
 
 }  // namespace lidar_stereo_fusion
