@@ -262,7 +262,10 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
     PatchMatchResult matched = patchmatch_.compute(left, right);
     result.disparity = matched.disparity;
     if (fused && params_.patchmatch.output_median > 0) {
-      result.disparity = medianOfValues(result.disparity, params_.patchmatch.output_median);
+      // The median removes speckles, not the LiDAR's points that the matcher confirms.
+      result.disparity = medianKeepingMeasured(
+          result.disparity, params_.patchmatch.output_median, left_sparse.disparity,
+          left_prior.lines.disparity, static_cast<float>(params_.confidence.edge_tolerance));
     }
     stats.patchmatch_steps = std::move(matched.steps);
   } else {

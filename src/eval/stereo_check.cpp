@@ -25,8 +25,9 @@ StereoCheckCounts removeStereoOutliers(cv::Mat1f& depth, const cv::Mat1f& stereo
                                        const StereoCamera& camera, double max_diff_px) {
   camera.validate();
   if (depth.size() != stereo_disparity.size()) {
-    throw std::invalid_argument("removeStereoOutliers: the reference and the stereo disparity "
-                                "differ in size");
+    throw std::invalid_argument(
+        "removeStereoOutliers: the reference and the stereo disparity "
+        "differ in size");
   }
   if (!(max_diff_px > 0) || !std::isfinite(max_diff_px)) {
     throw std::invalid_argument("removeStereoOutliers: max_diff_px must be > 0 and finite, got " +

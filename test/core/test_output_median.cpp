@@ -1,6 +1,8 @@
 // The output median (core/output_median.h) on small maps with exact answers: speckles and lines
 // narrower than the window go, wider structures stay, empty pixels stay empty and do not count,
-// the border is replicated; the parameter takes 0, 3 or 5 only.
+// the border is replicated; the parameter takes 0, 3 or 5 only. The LiDAR's points the output
+// agrees with keep their value (medianKeepingMeasured), and which points count as measured.
+#include <cmath>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -53,6 +55,64 @@ TEST(OutputMedian, EmptyPixelsStayEmptyAndDoNotCount) {
   pair(0, 0) = pair(0, 1) = 10.f;
   pair(1, 0) = pair(1, 1) = 14.f;
   EXPECT_EQ(medianOfValues(pair, 3)(0, 0), 10.f);
+}
+
+// A pole one pixel wide that the LiDAR measured on two rows (and the matcher kept): the plain
+// median erases it, the median that keeps measured points keeps those two pixels exactly and
+// removes the rest of the column as before; a measured point the output disagrees with by more
+// than the tolerance is filtered like any pixel.
+TEST(OutputMedian, MeasuredPointsTheOutputAgreesWithStay) {
+  cv::Mat1f d = flat();
+  d.col(4).setTo(20.f);
+  cv::Mat1f measured = cv::Mat1f::zeros(9, 9);
+  measured(2, 4) = 20.f;
+  measured(6, 4) = 20.2f;  // within 0.5 px of the output's 20
+  measured(7, 4) = 21.f;   // 1 px off: not confirmed by the output
+  EXPECT_EQ(countOf(medianOfValues(d, 3), 20.f), 0);
+  const cv::Mat1f out = medianKeepingMeasured(d, 3, measured, measured, 0.5f);
+  EXPECT_EQ(countOf(out, 20.f), 2);
+  EXPECT_EQ(out(2, 4), 20.f);
+  EXPECT_EQ(out(6, 4), 20.f);  // the output's value, not the point's
+  EXPECT_EQ(countOf(out, 10.f), 79);
+  // with no tolerance only the exact point stays; 5x5 the same way
+  EXPECT_EQ(countOf(medianKeepingMeasured(d, 3, measured, measured, 0.f), 20.f), 1);
+  EXPECT_EQ(countOf(medianKeepingMeasured(d, 5, measured, measured, 0.5f), 20.f), 2);
+  // an empty output pixel stays empty whatever was measured there
+  d(2, 4) = 0.f;
+  EXPECT_EQ(medianKeepingMeasured(d, 3, measured, measured, 0.5f)(2, 4), 0.f);
+  EXPECT_THROW(medianKeepingMeasured(d, 3, cv::Mat1f::zeros(9, 8), measured, 0.5f),
+               std::invalid_argument);
+  EXPECT_THROW(medianKeepingMeasured(d, 3, measured, cv::Mat1f::zeros(8, 9), 0.5f),
+               std::invalid_argument);
+  EXPECT_THROW(medianKeepingMeasured(d, 3, measured, measured, -1.f), std::invalid_argument);
+  EXPECT_THROW(medianKeepingMeasured(d, 3, measured, measured, NAN), std::invalid_argument);
+}
+
+// Measured: a projected point that the scan lines after Algorithm 1 still hold with its value;
+// not a point Algorithm 1 removed (0 there), nor one a nearer line crosses (another value), nor a
+// pixel the line completion filled between points.
+TEST(OutputMedian, MeasuredPointsAreTheProjectionsThatTheScanLinesKeep) {
+  cv::Mat1f sparse = cv::Mat1f::zeros(3, 6), lines = cv::Mat1f::zeros(3, 6);
+  sparse(1, 0) = 5.f;  // kept
+  lines(1, 0) = 5.f;
+  lines(1, 1) = 5.5f;  // completed between points: not measured
+  sparse(1, 2) = 6.f;  // kept
+  lines(1, 2) = 6.f;
+  sparse(1, 3) = 7.f;  // removed by Algorithm 1
+  sparse(1, 4) = 8.f;  // crossed by a nearer line
+  lines(1, 4) = 9.f;
+  const cv::Mat1f m = measuredPoints(sparse, lines);
+  const cv::Mat1f expected =
+      (cv::Mat1f(3, 6) << 0, 0, 0, 0, 0, 0, 5, 0, 6, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+  EXPECT_EQ(cv::countNonZero(m != expected), 0) << m;
+  EXPECT_THROW(measuredPoints(sparse, cv::Mat1f::zeros(3, 5)), std::invalid_argument);
+  // the median keeps exactly these: a map of speckles, each pixel of the projection's value
+  const cv::Mat1f speckles = cv::max(sparse, lines);
+  const cv::Mat1f out = medianKeepingMeasured(speckles, 3, sparse, lines, 0.f);
+  EXPECT_EQ(out(1, 0), 5.f);
+  EXPECT_EQ(out(1, 2), 6.f);
+  EXPECT_EQ(out(1, 1), medianOfValues(speckles, 3)(1, 1));
+  EXPECT_EQ(out(1, 4), medianOfValues(speckles, 3)(1, 4));
 }
 
 TEST(OutputMedian, OnlySizesThreeAndFive) {

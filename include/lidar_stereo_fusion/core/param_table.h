@@ -172,7 +172,7 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
     p.median_radius);
   v(ParamSpec{"output_median", g, within(0, 5), "px",
               "Median of the fused output over this square (3 or 5; 0 = none): removes "
-              "speckles, and with 5 lines under 3 px wide"},
+              "speckles, and with 5 lines under 3 px wide; LiDAR points stay"},
     p.output_median);
   v(ParamSpec{"confidence_weighting",
               g,

@@ -20,8 +20,8 @@ namespace lidar_stereo_fusion {
 
 /// What the stereo check removed.
 struct StereoCheckCounts {
-  int checked = 0;           ///< reference pixels looked at
-  int removed_no_stereo = 0;  ///< of them: SGBM has no disparity there
+  int checked = 0;              ///< reference pixels looked at
+  int removed_no_stereo = 0;    ///< of them: SGBM has no disparity there
   int removed_disagreeing = 0;  ///< of them: SGBM's disparity differs by more than max_diff_px
 };
 
