@@ -75,12 +75,21 @@ void completeRing(const std::vector<RingPoint>& points, short ring, const BIPara
     if (i + 1 == points.size()) break;
     const RingPoint& b = points[i + 1];
     const int span = b.x - a.x;
-    if (span < 2 || span > params.max_gap_px || std::abs(b.d - a.d) > params.max_jump_disp) {
-      continue;
-    }
+    if (span < 2 || span > params.max_gap_px) continue;
+    const bool step = std::abs(b.d - a.d) > params.max_jump_disp;
+    if (step && !params.step_fill) continue;
     for (int x = a.x + 1; x < b.x; ++x) {
       const double t = static_cast<double>(x - a.x) / span;
       const int y = roundToPixel(a.y + t * (b.y - a.y));
+      if (step) {  // a depth edge somewhere between the two: each side to the middle
+        const int twice = 2 * (x - a.x);
+        writeNearest(lines, x, y,
+                     twice < span   ? a.d
+                     : twice > span ? b.d
+                                    : std::max(a.d, b.d),
+                     ring);
+        continue;
+      }
       const double d = a.d + t * (static_cast<double>(b.d) - a.d);
       writeNearest(lines, x, y, static_cast<float>(d), ring);
     }

@@ -126,7 +126,10 @@ RegionMasks computeRegionMasks(const SparseDisparity& fed, const cv::Mat& image,
   }
   masks.inside = 255 - masks.above;
 
-  const BIParams bi;  // the default BI* scan lines, as the pipeline's prior uses them
+  // The default BI* scan lines, as the pipeline's prior uses them, but with the paper's gaps
+  // across jumps (step_fill off): the regions stay those of earlier releases, comparable.
+  BIParams bi;
+  bi.step_fill = false;
   ScanLines lines = completeScanLines(fed, bi);
   removeOccludedPoints(lines, image, bi);
   const ScanLineBounds bounds = computeScanLineBounds(lines, 0.0);

@@ -45,6 +45,7 @@ TEST(CompleteScanLines, DoesNotBridgeWideGapsOrDisparityJumps) {
   BIParams params;
   params.max_gap_px = 6;
   params.max_jump_disp = 2.0;
+  params.step_fill = false;  // the paper's completion
   SparseDisparity s = emptySparse(30, 60);
   addPoint(s, 0, 2, 10.f, 0);  // span 6 = max_gap_px: bridged
   addPoint(s, 6, 2, 10.f, 0);
@@ -59,6 +60,38 @@ TEST(CompleteScanLines, DoesNotBridgeWideGapsOrDisparityJumps) {
   for (int x = 0; x <= 4; ++x) EXPECT_EQ(l.disparity(8, x), 10.f + 0.5f * x) << x;
   for (int x = 5; x < 8; ++x) EXPECT_EQ(l.disparity(8, x), 0.f) << x;
   EXPECT_EQ(l.disparity(8, 8), 14.5f);
+}
+
+// step_fill: across a jump larger than max_jump_disp (within max_gap_px) each side keeps its
+// value up to the middle, the middle itself takes the nearer (larger d); the row is interpolated
+// as for a smooth line; wide gaps stay gaps.
+TEST(CompleteScanLines, AJumpWithinTheGapLimitBecomesAStepInTheMiddle) {
+  BIParams params;
+  params.max_gap_px = 6;
+  params.max_jump_disp = 2.0;
+  ASSERT_TRUE(params.step_fill);  // the default
+  SparseDisparity s = emptySparse(30, 60);
+  addPoint(s, 0, 8, 10.f, 1);  // |delta d| = 2 = max_jump_disp: interpolated
+  addPoint(s, 4, 8, 12.f, 1);
+  addPoint(s, 8, 8, 14.5f, 1);   // 2.5: a step, span 4 (even): x 5 -> 12, x 6 (middle) -> 14.5
+  addPoint(s, 13, 10, 4.f, 1);   // span 5 (odd), rows 8 -> 10: x 9, 10 -> 14.5; 11, 12 -> 4
+  addPoint(s, 20, 10, 30.f, 1);  // span 7 > max_gap_px: a gap
+  const ScanLines l = completeScanLines(s, params);
+  for (int x = 0; x <= 4; ++x) EXPECT_EQ(l.disparity(8, x), 10.f + 0.5f * x) << x;
+  EXPECT_EQ(l.disparity(8, 5), 12.f);
+  EXPECT_EQ(l.disparity(8, 6), 14.5f);
+  EXPECT_EQ(l.disparity(8, 7), 14.5f);
+  EXPECT_EQ(l.disparity(8, 8), 14.5f);
+  // rows 8 + 2 t, t = 1/5 .. 4/5: 8.4, 8.8, 9.2, 9.6 round to 8, 9, 9, 10
+  EXPECT_EQ(l.disparity(8, 9), 14.5f);
+  EXPECT_EQ(l.disparity(9, 10), 14.5f);
+  EXPECT_EQ(l.disparity(9, 11), 4.f);
+  EXPECT_EQ(l.disparity(10, 12), 4.f);
+  EXPECT_EQ(l.disparity(10, 13), 4.f);
+  EXPECT_EQ(l.ring(8, 6), 1);
+  for (int x = 14; x < 20; ++x) {
+    for (int y = 0; y < 30; ++y) EXPECT_EQ(l.disparity(y, x), 0.f) << x << " " << y;
+  }
 }
 
 TEST(CompleteScanLines, ZBufferKeepsTheNearerLineWhereTwoLinesMeet) {

@@ -41,6 +41,13 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, BIParams>> visitParams(P&& p, V
   v(ParamSpec{"max_gap_px", g, atLeast(0), "px", "Scan-line completion does not bridge wider gaps"},
     p.max_gap_px);
   v(ParamSpec{"max_jump_disp", g, atLeast(0), "px", "Nor larger disparity jumps"}, p.max_jump_disp);
+  v(ParamSpec{"step_fill",
+              g,
+              {},
+              "",
+              "Across a larger jump (within max_gap_px) each pixel takes the nearer point along "
+              "the ring, the step in the middle (false: a gap, the paper)"},
+    p.step_fill);
   v(ParamSpec{"max_disp_diff", g, atLeast(0), "px",
               "Algorithm 1 Maxdisp: foreground must exceed d by this"},
     p.max_disp_diff);

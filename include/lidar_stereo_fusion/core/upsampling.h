@@ -13,8 +13,11 @@
 namespace lidar_stereo_fusion {
 
 struct BIParams {
-  int max_gap_px = 12;           ///< completion does not bridge gaps wider than this [px]
-  double max_jump_disp = 2.0;    ///< nor jumps in disparity larger than this [px]
+  int max_gap_px = 12;         ///< completion does not bridge gaps wider than this [px]
+  double max_jump_disp = 2.0;  ///< nor jumps in disparity larger than this [px]
+  /// Across a larger jump (within max_gap_px) each pixel takes the nearer of the two points along
+  /// the ring: a step in the middle, where the depth edge lies on average (false: a gap, the paper)
+  bool step_fill = true;
   double max_disp_diff = 1.5;    ///< Algorithm 1 "Maxdisp": foreground must exceed d by this [px]
   double max_color_diff = 60.0;  ///< Algorithm 1 "Maxcolor": RGB L1 distance [0..765]
   int search_lines = 2;      ///< Algorithm 1 looks at this many scan lines up and down (paper: 1)
@@ -41,7 +44,10 @@ struct ScanLines {
 /// BI* step 1: interpolates each ring linearly along x between consecutive projected points
 /// (sorted by x): for x0 < x < x1, d = d0 + t (d1 - d0) and row = round(y0 + t (y1 - y0)),
 /// t = (x - x0) / (x1 - x0). Neighbours are bridged only when x1 - x0 <= max_gap_px and
-/// |d1 - d0| <= max_jump_disp. Where two lines hit one pixel the nearer (larger d) wins. Points
+/// |d1 - d0| <= max_jump_disp; with step_fill, neighbours within max_gap_px across a larger jump
+/// are bridged by a step: x - x0 < (x1 - x0) / 2 takes d0, beyond the middle d1, the middle
+/// itself the larger (row interpolated as above). Where two lines hit one pixel the nearer
+/// (larger d) wins. Points
 /// without a ring (ring < 0, or an empty ring map) are kept as single pixels. Throws
 /// std::invalid_argument on an empty map, a ring map of another size, or values that are not
 /// finite and >= 0.
