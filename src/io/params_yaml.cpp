@@ -215,6 +215,43 @@ void requireTopLevelMap(const std::string& raw, const std::string& path) {
   }
 }
 
+/// A parameter file holds names and values, in sections at most: every line but blank lines,
+/// comments, a "%YAML" directive and document markers is "name: value" or "name:" (a section),
+/// the name letters, digits and '_', indented by spaces and never less than the first name.
+/// OpenCV 4.6's YAML parser never returns on some documents outside that form (" d:0", then
+/// "x.", then "-": found by fuzz_params_yaml), so they are refused, naming the line, before it
+/// parses them.
+void requireNameValueLines(const std::string& raw, const std::string& path) {
+  std::istringstream lines(raw);
+  std::string line;
+  std::size_t base = std::string::npos;  // the first name's indentation
+  for (int number = 1; std::getline(lines, line); ++number) {
+    const auto fail = [&](const std::string& what) {
+      throw std::runtime_error("params YAML " + path + " line " + std::to_string(number) + ": " +
+                               what);
+    };
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#' || (first == 0 && line[0] == '%') ||
+        line.compare(first, 3, "---") == 0 || line.compare(first, 3, "...") == 0) {
+      continue;
+    }
+    if (line.find('\t') < first) fail("a tab in the indentation (YAML indents with spaces)");
+    std::size_t end = first;
+    while (end < line.size() &&
+           (std::isalnum(static_cast<unsigned char>(line[end])) != 0 || line[end] == '_')) {
+      ++end;
+    }
+    if (end == first || end >= line.size() || line[end] != ':') {
+      fail("not 'name: value' (a parameter file holds names and values, in sections at most)");
+    }
+    if (base == std::string::npos) base = first;
+    if (first < base) {
+      fail("indented by " + std::to_string(first) + " spaces, less than the first name's " +
+           std::to_string(base));
+    }
+  }
+}
+
 }  // namespace
 
 cv::FileStorage openYaml(const std::string& path) {
@@ -222,6 +259,7 @@ cv::FileStorage openYaml(const std::string& path) {
   requireTextFile(raw, path, "params YAML");
   requireYamlMarkersAlone(raw, path, "params YAML");
   requireTopLevelMap(raw, path);
+  requireNameValueLines(raw, path);
   const std::string text = withYamlDirective(raw);
   cv::FileStorage fs;
   try {

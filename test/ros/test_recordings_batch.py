@@ -70,6 +70,15 @@ def test_row12_a_lost_scheduler_stops_the_batch_and_its_bag_runners(long_bag):
                               stderr=subprocess.STDOUT, start_new_session=True)
     out = scratch("row12_lost")
     try:
+        # The scheduler is up and the worker registered before the batch starts: this row is a
+        # scheduler lost mid-run, not one still starting (which lsf_batch refuses after its
+        # --connect-timeout, row 12's other test; under a loaded CI host the start took longer).
+        scheduler_log = os.path.join(logs, "scheduler.log")
+        deadline = time.time() + DEADLINE
+        while time.time() < deadline and "Register worker" not in open(scheduler_log).read():
+            assert scheduler.poll() is None and worker.poll() is None, "the cluster did not start"
+            time.sleep(0.1)
+        assert "Register worker" in open(scheduler_log).read(), "no worker registered"
         proc = subprocess.Popen([sys.executable, LSF_BATCH, "--bag-runner", BAG_RUNNER,
                                  "--scheduler", address, "--out", out, long_bag],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -77,7 +86,9 @@ def test_row12_a_lost_scheduler_stops_the_batch_and_its_bag_runners(long_bag):
         deadline = time.time() + DEADLINE
         while time.time() < deadline and proc.poll() is None and not bag_runners_under(worker.pid):
             time.sleep(0.05)
-        assert bag_runners_under(worker.pid), "no task started"
+        if not bag_runners_under(worker.pid):
+            proc.kill()
+            pytest.fail("no task started; lsf_batch: %s" % (proc.communicate()[1],))
         os.killpg(scheduler.pid, signal.SIGKILL)
         stdout, stderr = proc.communicate(timeout=DEADLINE)
         assert proc.returncode == 1, stderr
