@@ -5,7 +5,10 @@
 //   bi: {max_gap_px: 12, ...}
 //   bf: {radius: 6, ...}
 //   patchmatch: {window_radius: 5, alpha: 0.1, ...}
-// Every key is optional; unknown keys are an error (typos must not pass silently).
+// Every key is optional; unknown keys are an error (typos must not pass silently). Every line
+// but blank lines, comments, a "%YAML" directive and document markers is "name: value" or a
+// section "name:", indented by spaces and never less than the first name (OpenCV 4.6's parser
+// never returns on some documents outside that form: they are refused by line first).
 #pragma once
 
 #include <string>
