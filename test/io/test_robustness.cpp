@@ -75,7 +75,6 @@ TEST(Robustness, BinaryYamlAndUnquotedBigSeedAreNamedProperly) {
   EXPECT_EQ(yamlLoadError("patchmatch:\n  seed: \"3000000000\"\n"), "");
 }
 
-// Point 5: a right projection in millimetres gives a 1000x baseline.
 TEST(Robustness, YamlLinesThatAreNotNameAndValueAreErrorsBeforeOpenCvParsesThem) {
   // OpenCV 4.6's parser never returns on " d:0\nx.\n-" (found by fuzz_params_yaml in CI: a
   // map's first name indented, then lines that are neither): every line must be "name: value"
@@ -102,6 +101,7 @@ TEST(Robustness, YamlLinesThatAreNotNameAndValueAreErrorsBeforeOpenCvParsesThem)
   }
 }
 
+// Point 5: a right projection in millimetres gives a 1000x baseline.
 TEST(Robustness, ImplausibleBaselineNamesTheValueAndTheUnitMistake) {
   EXPECT_EQ(baselinePlausibilityProblem(0.537), "");
   EXPECT_EQ(baselinePlausibilityProblem(0.063), "");
