@@ -6,21 +6,13 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "eval_test_scenes.h"
 #include "lidar_stereo_fusion/eval/stereo_check.h"
 
 namespace lidar_stereo_fusion {
 namespace {
 
-StereoCamera camera(int width, int height) {
-  StereoCamera c;
-  c.fx = c.fy = 100.0;
-  c.cx = width / 2.0;
-  c.cy = height / 2.0;
-  c.baseline = 0.5;  // fx * baseline = 50: z = 10 m is 5 px
-  c.width = width;
-  c.height = height;
-  return c;
-}
+using test::camera;
 
 TEST(StereoCheck, KeepsAgreeingPixelsAndRemovesTheRestByReason) {
   cv::Mat1f depth(2, 4, 0.f), stereo(2, 4, 0.f);
@@ -54,12 +46,9 @@ TEST(StereoCheck, RefusesWrongSizesAndTolerances) {
 }
 
 TEST(StereoCheck, SgbmFindsTheDisparityOfATexturedPlane) {
-  // right(x) = left(x + 20): a fronto-parallel plane at 20 px, random texture (SGBM needs one)
-  cv::Mat1b wide(120, 360);
-  cv::RNG rng(7);
-  rng.fill(wide, cv::RNG::UNIFORM, 0, 256);
-  cv::GaussianBlur(wide, wide, cv::Size(3, 3), 0.8);
-  const cv::Mat left = wide.colRange(40, 340).clone(), right = wide.colRange(60, 360).clone();
+  // a fronto-parallel plane at 20 px, random texture (SGBM needs one)
+  cv::Mat1b left, right;
+  test::shiftedTexture(300, 120, 20, left, right);
   cv::Mat bgr_left, bgr_right;
   cv::cvtColor(left, bgr_left, cv::COLOR_GRAY2BGR);
   cv::cvtColor(right, bgr_right, cv::COLOR_GRAY2BGR);

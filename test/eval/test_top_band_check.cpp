@@ -3,33 +3,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "eval_test_scenes.h"
 #include "lidar_stereo_fusion/eval/top_band_check.h"
 
 namespace lsf = lidar_stereo_fusion;
 
 namespace {
 
-lsf::StereoCamera camera(int w, int h) {
-  lsf::StereoCamera c;
-  c.fx = c.fy = 100.0;
-  c.cx = w / 2.0;
-  c.cy = h / 2.0;
-  c.baseline = 0.5;  // f B = 50 px m
-  c.width = w;
-  c.height = h;
-  return c;
-}
-
-/// Random texture (fixed seed): the right image is the left shifted by `shift` px.
-void texture(int w, int h, int shift, cv::Mat1b& left, cv::Mat1b& right) {
-  left.create(h, w);
-  cv::RNG rng(7);
-  rng.fill(left, cv::RNG::UNIFORM, 0, 256);
-  right = cv::Mat1b::zeros(h, w);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x + shift < w; ++x) right(y, x) = left(y, x + shift);
-  }
-}
+using lsf::test::camera;
+using lsf::test::shiftedTexture;
 
 }  // namespace
 
@@ -37,7 +19,7 @@ TEST(TopBand, CountsNearPlanesAboveFarTopsAndExcusesWhatTheLidarOrImagesShow) {
   const int w = 40, h = 30;
   const lsf::StereoCamera cam = camera(w, h);
   cv::Mat1b left, right;
-  texture(w, h, 2, left, right);  // the images match at 2 px (25 m) everywhere
+  shiftedTexture(w, h, 2, left, right);  // the images match at 2 px (25 m) everywhere
   cv::Mat1f fed = cv::Mat1f::zeros(h, w), out = cv::Mat1f::zeros(h, w);
   for (int x = 0; x < w; ++x) fed(20, x) = 2.f;  // the top line: 25 m
   out.setTo(2.f);
@@ -57,7 +39,7 @@ TEST(TopBand, CountsNearPlanesAboveFarTopsAndExcusesWhatTheLidarOrImagesShow) {
   EXPECT_EQ(r.banded, 3);
 
   // The images: with the right image shifted by 5 px the near disparity matches, the far not.
-  texture(w, h, 5, left, right);
+  shiftedTexture(w, h, 5, left, right);
   r = lsf::checkTopBand(fed, out, left, right, cam);
   EXPECT_EQ(r.banded, 0);
   EXPECT_EQ(r.excused, 5);
