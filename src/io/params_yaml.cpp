@@ -17,8 +17,8 @@
 #include <limits>
 #include <map>
 #include <set>
-#include <sstream>
 #include <stdexcept>
+#include <string_view>
 
 namespace lidar_stereo_fusion {
 namespace {
@@ -195,45 +195,26 @@ void YamlParamReader::read(const cv::FileNode& node, const ParamSpec& spec,
 
 namespace {
 
-/// A parameter file is a map. OpenCV 4.6's YAML parser never returns on some documents whose top
-/// level is a sequence ("[m]" or "- ..." followed by more lines; found by fuzz_params_yaml), so a
-/// top-level sequence is refused before it is parsed.
-void requireTopLevelMap(const std::string& raw, const std::string& path) {
-  std::istringstream lines(raw);
-  std::string line;
-  for (int number = 1; std::getline(lines, line); ++number) {
-    const std::size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#' || line[first] == '%' ||
-        line.compare(first, 3, "---") == 0 || line.compare(first, 3, "...") == 0) {
-      continue;
-    }
-    if (line[first] == '[' || line[first] == '-') {
-      throw std::runtime_error("params YAML " + path + " line " + std::to_string(number) +
-                               ": top level is not a map (a sequence starts here)");
-    }
-    return;
-  }
-}
-
 /// A parameter file holds names and values, in sections at most: every line but blank lines,
 /// comments, a "%YAML" directive and document markers is "name: value" or "name:" (a section),
 /// the name letters, digits and '_', indented by spaces and never less than the first name.
-/// OpenCV 4.6's YAML parser never returns on some documents outside that form (" d:0", then
-/// "x.", then "-": found by fuzz_params_yaml), so they are refused, naming the line, before it
-/// parses them.
+/// OpenCV 4.6's YAML parser never returns on some documents outside that form (found by
+/// fuzz_params_yaml: a top-level sequence, "[m]" or "- ..." followed by more lines; " d:0", then
+/// "x.", then "-"), so they are refused, naming the line, before it parses them.
 void requireNameValueLines(const std::string& raw, const std::string& path) {
-  std::istringstream lines(raw);
-  std::string line;
-  std::size_t base = std::string::npos;  // the first name's indentation
-  for (int number = 1; std::getline(lines, line); ++number) {
+  std::size_t base = std::string_view::npos;  // the first name's indentation
+  forEachLine(raw, [&](int number, std::string_view line) {
     const auto fail = [&](const std::string& what) {
       throw std::runtime_error("params YAML " + path + " line " + std::to_string(number) + ": " +
                                what);
     };
     const std::size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#' || (first == 0 && line[0] == '%') ||
-        line.compare(first, 3, "---") == 0 || line.compare(first, 3, "...") == 0) {
-      continue;
+    if (first == std::string_view::npos || line[first] == '#' || (first == 0 && line[0] == '%') ||
+        line.substr(first, 3) == "---" || line.substr(first, 3) == "...") {
+      return;
+    }
+    if (base == std::string_view::npos && (line[first] == '[' || line[first] == '-')) {
+      fail("top level is not a map (a sequence starts here)");
     }
     if (line.find('\t') < first) fail("a tab in the indentation (YAML indents with spaces)");
     std::size_t end = first;
@@ -244,12 +225,12 @@ void requireNameValueLines(const std::string& raw, const std::string& path) {
     if (end == first || end >= line.size() || line[end] != ':') {
       fail("not 'name: value' (a parameter file holds names and values, in sections at most)");
     }
-    if (base == std::string::npos) base = first;
+    if (base == std::string_view::npos) base = first;
     if (first < base) {
       fail("indented by " + std::to_string(first) + " spaces, less than the first name's " +
            std::to_string(base));
     }
-  }
+  });
 }
 
 }  // namespace
@@ -258,7 +239,6 @@ cv::FileStorage openYaml(const std::string& path) {
   const std::string raw = readTextFile(path, "params YAML");
   requireTextFile(raw, path, "params YAML");
   requireYamlMarkersAlone(raw, path, "params YAML");
-  requireTopLevelMap(raw, path);
   requireNameValueLines(raw, path);
   const std::string text = withYamlDirective(raw);
   cv::FileStorage fs;
