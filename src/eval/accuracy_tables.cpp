@@ -75,6 +75,11 @@ std::string regionTable(const LayoutScores<Metrics>& layout, const std::vector<R
   return out;
 }
 
+/// "N (P %)": a count and its share of `total`.
+std::string share(long n, long total) {
+  return std::to_string(n) + " (" + format("%.1f", 100.0 * n / std::max(1L, total)) + " %)";
+}
+
 }  // namespace
 
 std::string formatMiddleburyLayout(const LayoutScores<DisparityMetrics>& layout) {
@@ -123,10 +128,6 @@ std::string formatDepthBands(const LayoutScores<DepthMetrics>& layout) {
 }
 
 std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference) {
-  // "N (P %)": a count and its share of `total`.
-  const auto share = [](long n, long total) {
-    return std::to_string(n) + " (" + format("%.1f", 100.0 * n / std::max(1L, total)) + " %)";
-  };
   const long image = static_cast<long>(reference.depth.total());
   const long other = reference.other_points;
   std::string out = row({"reference", "value"}) + separator(2);
@@ -147,14 +148,11 @@ std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference)
 
 std::string formatStereoCheck(const StereoCheckCounts& counts, double max_diff_px) {
   if (!(max_diff_px > 0.0)) return "";
-  const auto share = [&](int n) {
-    return std::to_string(n) + " (" + format("%.1f", 100.0 * n / std::max(1, counts.checked)) +
-           " %)";
-  };
   return row({"stereo check: reference pixels checked", std::to_string(counts.checked)}) +
-         row({"removed: SGBM has no disparity there", share(counts.removed_no_stereo)}) +
+         row({"removed: SGBM has no disparity there",
+              share(counts.removed_no_stereo, counts.checked)}) +
          row({"removed: SGBM differs by more than " + format("%g", max_diff_px) + " px",
-              share(counts.removed_disagreeing)});
+              share(counts.removed_disagreeing, counts.checked)});
 }
 
 }  // namespace lidar_stereo_fusion
