@@ -27,6 +27,7 @@
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
+#include "lidar_stereo_fusion/io/process_memory.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/sim/synthetic_frame.h"
 
@@ -57,6 +58,8 @@ Options:
   --threads N        threads for both (default 0 = all cores)
   --params <yaml>    parameters (e.g. config/paper.yaml); --method overrides its 'method'
   --no-sgbm          skip the SGBM reference
+  --release-memory   freed memory goes back to the kernel as glibc decides (the default keeps it,
+                     as the node's keep_freed_memory does: io/process_memory.h)
   --help             this text
 )";
 
@@ -72,7 +75,7 @@ double timeMs(const std::function<void()>& f) {
 struct Options {
   std::string drive, frame, method, params, synthetic;
   int repeat = 5, threads = 0, rings = 64;
-  bool sgbm = true;
+  bool sgbm = true, keep_memory = true;
 };
 
 std::string defaultDrive() {
@@ -85,9 +88,10 @@ Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(argc, argv,
                             {"--kitti-raw", "--frame", "--repeat", "--method", "--threads",
                              "--params", "--synthetic", "--rings"},
-                            {"--no-sgbm"});
+                            {"--no-sgbm", "--release-memory"});
   Options o;
   o.sgbm = !cl.has("--no-sgbm");
+  o.keep_memory = !cl.has("--release-memory");
   o.drive = cl.value("--kitti-raw", defaultDrive());
   o.frame = cl.value("--frame");
   o.synthetic = cl.value("--synthetic");
@@ -228,6 +232,10 @@ int run(const Options& o) {
   if (!o.method.empty()) params.method = lsf::parseMethod(o.method);
   params.patchmatch.num_threads = o.threads;
   lsf::applySimdEnvironment(params);
+  std::string memory_problem;
+  const bool kept = o.keep_memory && lsf::keepFreedMemory(&memory_problem);
+  if (!memory_problem.empty())
+    std::fprintf(stderr, "fusion_benchmark: %s\n", memory_problem.c_str());
   const int threads = o.threads > 0 ? o.threads : omp_get_max_threads();
   omp_set_num_threads(threads);
   cv::setNumThreads(threads);
@@ -237,11 +245,11 @@ int run(const Options& o) {
       o.synthetic.empty() ? kittiCases(o) : std::vector<Case>{syntheticCase(o)};
   const cv::Size size = cases.front().input.left.size();
   std::printf(
-      "fusion_benchmark: %s (%dx%d, %zu points), method %s, %d threads, SIMD %s, 1 warm-up + %d "
-      "runs\n",
+      "fusion_benchmark: %s (%dx%d, %zu points), method %s, %d threads, SIMD %s, freed memory "
+      "%s, 1 warm-up + %d runs\n",
       cases.size() == 1 ? cases.front().name.c_str() : "every frame", size.width, size.height,
       cases.front().input.cloud.size(), lsf::methodName(params.method).c_str(), threads,
-      lsf::simdPathName(params.patchmatch.simd_path), o.repeat);
+      lsf::simdPathName(params.patchmatch.simd_path), kept ? "kept" : "released", o.repeat);
   cv::Ptr<cv::StereoSGBM> sgbm;
   if (o.sgbm) {
     sgbm = lsf::referenceSgbm();

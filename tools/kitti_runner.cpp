@@ -23,6 +23,7 @@
 #include "lidar_stereo_fusion/io/kitti_sweep.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
 #include "lidar_stereo_fusion/io/pcd.h"
+#include "lidar_stereo_fusion/io/process_memory.h"
 #include "lidar_stereo_fusion/io/progress.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
 
@@ -133,6 +134,9 @@ lsf::FusionParams loadParams(const Options& o) {
   if (o.method) params.method = lsf::parseMethod(*o.method);
   lsf::applySimdEnvironment(params);
   params.validate();
+  std::string memory_problem;  // frames reuse the last frame's pages (io/process_memory.h)
+  if (!lsf::keepFreedMemory(&memory_problem))
+    std::cerr << "kitti_runner: " << memory_problem << "\n";
   return params;
 }
 

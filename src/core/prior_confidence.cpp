@@ -68,26 +68,47 @@ cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
   const float inv_decay = params.decay_rows > 0 ? static_cast<float>(1.0 / params.decay_rows) : 0.f;
   const float removed_factor = static_cast<float>(params.removed_factor);
 
-  cv::Mat1f confidence = cv::Mat1f::zeros(prior.size());
+  // The distance factor by row distance to the nearer line, tabulated (the same float expression).
+  std::vector<float> near(static_cast<size_t>(rows / 2 + 1));
+  for (size_t dist = 0; dist < near.size(); ++dist) {
+    near[dist] = std::exp(-std::max(0.f, static_cast<float>(dist) - near_rows) * inv_decay);
+  }
+  // Row by row (a column walk writes a cache line per pixel): each column keeps the interval it is
+  // in (rows, agreement; y_down -1 where it is not bridged), set when the row passes a line.
+  cv::Mat1f confidence(prior.size());
   const ColumnIndex index(lines.disparity);
-  for (int x = 0; x < cols; ++x) {
-    const ColumnEntry* e = index.column(x);
-    const int n = index.size(x);
-    const std::vector<int>& gone = removed_rows[x];
-    for (int k = 0; k < n; ++k) {
-      if (prior(e[k].y, x) > 0.f) confidence(e[k].y, x) = 1.f;
-      if (k + 1 == n) break;
-      const int y_up = e[k].y, y_down = e[k + 1].y;
-      if (y_down - y_up < 2 || !(prior(y_up + 1, x) > 0.f)) continue;  // adjacent, or not bridged
-      const float r = intervalResidual(e, n, k, max_slope);
-      float agree = std::exp(-std::max(0.f, r - tolerance) * inv_sigma);
-      const auto it = std::upper_bound(gone.begin(), gone.end(), y_up);
-      if (it != gone.end() && *it < y_down) agree *= removed_factor;
-      for (int y = y_up + 1; y < y_down; ++y) {
-        const float dist = static_cast<float>(std::min(y - y_up, y_down - y));
-        const float near = std::exp(-std::max(0.f, dist - near_rows) * inv_decay);
-        if (prior(y, x) > 0.f) confidence(y, x) = agree * near;
-      }
+  std::vector<int> line_index(static_cast<size_t>(cols), 0), y_up(line_index),
+      y_down(static_cast<size_t>(cols), -1);
+  std::vector<float> agree(static_cast<size_t>(cols), 0.f);
+  for (int y = 0; y < rows; ++y) {
+    const float* p = prior[y];
+    float* c = confidence[y];
+    for (int x = 0; x < cols; ++x) {
+      const int up = y_up[static_cast<size_t>(x)], down = y_down[static_cast<size_t>(x)];
+      c[x] = y < down && p[x] > 0.f
+                 ? agree[static_cast<size_t>(x)] * near[std::min(y - up, down - y)]
+                 : 0.f;
+    }
+    const float* on_line = lines.disparity[y];
+    for (int x = 0; x < cols; ++x) {
+      if (!(on_line[x] > 0.f)) continue;
+      const size_t xs = static_cast<size_t>(x);
+      const ColumnEntry* e = index.column(x);
+      const int n = index.size(x);
+      const int k = line_index[xs]++;  // e[k] is this pixel
+      c[x] = p[x] > 0.f ? 1.f : 0.f;
+      y_down[xs] = -1;
+      if (k + 1 == n) continue;
+      const int y_next = e[k + 1].y;
+      if (y_next - y < 2 || !(prior(y + 1, x) > 0.f)) continue;  // adjacent, or not bridged
+      float a =
+          std::exp(-std::max(0.f, intervalResidual(e, n, k, max_slope) - tolerance) * inv_sigma);
+      const std::vector<int>& gone = removed_rows[xs];
+      const auto it = std::upper_bound(gone.begin(), gone.end(), y);
+      if (it != gone.end() && *it < y_next) a *= removed_factor;
+      y_up[xs] = y;
+      y_down[xs] = y_next;
+      agree[xs] = a;
     }
   }
   return confidence;

@@ -234,26 +234,38 @@ ScanLineBounds computeScanLineBounds(const ScanLines& lines, double margin_px) {
     throw std::invalid_argument("computeScanLineBounds: margin_px must be finite and >= 0, got " +
                                 std::to_string(margin_px));
   }
+  // Row by row (a column walk writes a cache line per pixel): each column keeps the bounds of the
+  // interval it is in, set when the row passes a line; a pixel on a line takes the lines around it.
   const ColumnIndex index(lines.disparity);
+  const int rows = lines.disparity.rows, cols = lines.disparity.cols;
   ScanLineBounds bounds;
-  bounds.lo = cv::Mat1f::zeros(lines.disparity.size());
-  bounds.hi = cv::Mat1f::zeros(lines.disparity.size());
-  bounds.range = cv::Mat1f::zeros(lines.disparity.size());
-  for (int x = 0; x < index.cols(); ++x) {
-    const ColumnEntry* entries = index.column(x);
-    const int n = index.size(x);
-    if (n < 2) continue;
-    // For row y, "up" is the nearest line strictly above y and "down" the nearest strictly below.
-    int next = 0;  // index of the first line with row > y
-    for (int y = entries[0].y + 1; y < entries[n - 1].y; ++y) {
-      while (next < n && entries[next].y <= y) ++next;
-      const int up_index = entries[next - 1].y == y ? next - 2 : next - 1;
-      if (up_index < 0 || next >= n) continue;
-      const float d_up = entries[up_index].d;
-      const float d_down = entries[next].d;
-      bounds.lo(y, x) = static_cast<float>(std::min(d_up, d_down) - margin_px);
-      bounds.hi(y, x) = static_cast<float>(std::max(d_up, d_down) + margin_px);
-      bounds.range(y, x) = std::abs(d_up - d_down);
+  bounds.lo.create(lines.disparity.size());
+  bounds.hi.create(lines.disparity.size());
+  bounds.range.create(lines.disparity.size());
+  cv::Mat1f interval = cv::Mat1f::zeros(3, cols);  // lo, hi, range of each column's interval
+  std::vector<int> line_index(static_cast<size_t>(cols), 0);  // the column's next line
+  const auto set = [margin_px](float d_up, float d_down, float& lo, float& hi, float& range) {
+    lo = static_cast<float>(std::min(d_up, d_down) - margin_px);
+    hi = static_cast<float>(std::max(d_up, d_down) + margin_px);
+    range = std::abs(d_up - d_down);
+  };
+  for (int y = 0; y < rows; ++y) {
+    float* lo = bounds.lo[y];
+    float* hi = bounds.hi[y];
+    float* range = bounds.range[y];
+    std::copy(interval[0], interval[0] + cols, lo);
+    std::copy(interval[1], interval[1] + cols, hi);
+    std::copy(interval[2], interval[2] + cols, range);
+    const float* on_line = lines.disparity[y];
+    for (int x = 0; x < cols; ++x) {
+      if (!(on_line[x] > 0.f)) continue;
+      const ColumnEntry* e = index.column(x);
+      const int k = line_index[static_cast<size_t>(x)]++;  // e[k] is this pixel
+      const bool below = k + 1 < index.size(x);
+      lo[x] = hi[x] = range[x] = 0.f;
+      if (k >= 1 && below) set(e[k - 1].d, e[k + 1].d, lo[x], hi[x], range[x]);
+      interval(0, x) = interval(1, x) = interval(2, x) = 0.f;
+      if (below) set(e[k].d, e[k + 1].d, interval(0, x), interval(1, x), interval(2, x));
     }
   }
   return bounds;

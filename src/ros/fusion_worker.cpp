@@ -12,6 +12,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <boost/bind/bind.hpp>
 
+#include "lidar_stereo_fusion/io/process_memory.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
 #include "lidar_stereo_fusion/ros/ego_motion.h"
 #include "lidar_stereo_fusion/ros/ros_params.h"
@@ -56,6 +57,10 @@ FusionWorker::FusionWorker(const ros::NodeHandle& nh, const ros::NodeHandle& pnh
   std::string simd_warning;  // the SIMD path is no parameter: LSF_SIMD, kept by reconfigure
   params_.patchmatch.simd_path = simdPathFromEnvironment(&simd_warning);
   if (!simd_warning.empty()) ROS_WARN_STREAM("[" << name_ << "] " << simd_warning);
+  std::string memory_problem;  // process-wide: the manager's other nodelets keep theirs too
+  if (node_params_.keep_freed_memory && !keepFreedMemory(&memory_problem)) {
+    ROS_WARN_STREAM("[" << name_ << "] keep_freed_memory: " << memory_problem);
+  }
   ros_params::writeParams(pnh_, params_);
 
   // Live parameters: start from the values just read, then follow dynamic_reconfigure.

@@ -51,6 +51,7 @@ const std::set<std::string>& ignoredNodeParams() {
                                                  "input_timeout",
                                                  "log_throttle_period",
                                                  "worker_nice",
+                                                 "keep_freed_memory",
                                                  "diagnostics/min_rate",
                                                  "diagnostics/max_rate",
                                                  "diagnostics/max_latency"};

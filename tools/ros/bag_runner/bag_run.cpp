@@ -14,6 +14,7 @@
 
 #include "bag_files.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
+#include "lidar_stereo_fusion/io/process_memory.h"
 #include "lidar_stereo_fusion/io/progress.h"
 #include "lidar_stereo_fusion/ros/ego_motion.h"
 
@@ -254,6 +255,10 @@ int BagRun::process() {
             << ", method " << methodName(params_.method) << ", "
             << (node_params_.approximate_sync ? "approximate" : "exact") << " image sync\n";
 
+  std::string memory_problem;  // as the node: frames reuse the last frame's pages
+  if (node_params_.keep_freed_memory && !keepFreedMemory(&memory_problem)) {
+    std::cerr << "bag_runner: keep_freed_memory: " << memory_problem << "\n";
+  }
   FusionPipeline pipeline(params_);
   OutputWriter writer(o_.outputs, node_params_);
   ProgressBar progress(std::cerr, window_.sets, ::isatty(2) != 0);
