@@ -9,6 +9,8 @@
 #include "lidar_stereo_fusion/core/motion_compensation.h"
 #include "lidar_stereo_fusion/core/output_median.h"
 
+#include "scan_line_columns.h"
+
 namespace lidar_stereo_fusion {
 
 namespace {
@@ -69,10 +71,15 @@ ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
                        const FusionParams& params) {
   ViewPrior v;
   std::vector<cv::Point> removed;
-  v.prior = upsampleBI(sparse, image, params.bi, &v.removed, &v.lines, &removed);
-  if (usesBF(params.method)) v.prior = upsampleBF(sparse, params.bf);
-  v.bounds = computeScanLineBounds(v.lines, params.patchmatch.bound_margin);
-  v.confidence = priorConfidence(v.lines, v.prior, removed, params.confidence);
+  // upsampleBI's steps, with one column index for Eq. 3, the bounds and the confidence.
+  v.lines = completeScanLines(sparse, params.bi);
+  v.removed = removeOccludedPoints(v.lines, image, params.bi, &removed);
+  const ColumnIndex index(v.lines.disparity);
+  v.prior = usesBF(params.method)
+                ? upsampleBF(sparse, params.bf)
+                : interpolateBetweenScanLines(index, v.lines.disparity, params.bi);
+  v.bounds = computeScanLineBounds(index, v.lines.disparity, params.patchmatch.bound_margin);
+  v.confidence = priorConfidence(index, v.lines.disparity, v.prior, removed, params.confidence);
   if (isFused(params.method) && params.patchmatch.confidence_weighting) {
     fillPriorHoles(v.prior, v.confidence, params.confidence);
   }

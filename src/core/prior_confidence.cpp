@@ -10,6 +10,7 @@
 #include <string>
 
 #include "column_index.h"
+#include "scan_line_columns.h"
 
 namespace lidar_stereo_fusion {
 
@@ -46,11 +47,17 @@ void PriorConfidenceParams::validate() const { requireRanges("PriorConfidencePar
 cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
                           const std::vector<cv::Point>& removed,
                           const PriorConfidenceParams& params) {
+  return priorConfidence(ColumnIndex(lines.disparity), lines.disparity, prior, removed, params);
+}
+
+cv::Mat1f priorConfidence(const ColumnIndex& index, const cv::Mat1f& lines, const cv::Mat1f& prior,
+                          const std::vector<cv::Point>& removed,
+                          const PriorConfidenceParams& params) {
   params.validate();
-  if (lines.disparity.empty() || prior.empty()) {
+  if (lines.empty() || prior.empty()) {
     throw std::invalid_argument("priorConfidence: empty scan lines or prior");
   }
-  if (lines.disparity.size() != prior.size()) {
+  if (lines.size() != prior.size()) {
     throw std::invalid_argument("priorConfidence: scan lines and prior differ in size");
   }
   const int rows = prior.rows, cols = prior.cols;
@@ -76,7 +83,6 @@ cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
   // Row by row (a column walk writes a cache line per pixel): each column keeps the interval it is
   // in (rows, agreement; y_down -1 where it is not bridged), set when the row passes a line.
   cv::Mat1f confidence(prior.size());
-  const ColumnIndex index(lines.disparity);
   std::vector<int> line_index(static_cast<size_t>(cols), 0), y_up(line_index),
       y_down(static_cast<size_t>(cols), -1);
   std::vector<float> agree(static_cast<size_t>(cols), 0.f);
@@ -89,7 +95,7 @@ cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
                  ? agree[static_cast<size_t>(x)] * near[std::min(y - up, down - y)]
                  : 0.f;
     }
-    const float* on_line = lines.disparity[y];
+    const float* on_line = lines[y];
     for (int x = 0; x < cols; ++x) {
       if (!(on_line[x] > 0.f)) continue;
       const size_t xs = static_cast<size_t>(x);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "column_index.h"
+#include "scan_line_columns.h"
 #include "upsampling_checks.h"
 
 namespace lidar_stereo_fusion {
@@ -194,10 +195,14 @@ int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams&
 }
 
 cv::Mat1f interpolateBetweenScanLines(const ScanLines& lines, const BIParams& params) {
+  return interpolateBetweenScanLines(ColumnIndex(lines.disparity), lines.disparity, params);
+}
+
+cv::Mat1f interpolateBetweenScanLines(const ColumnIndex& index, const cv::Mat1f& lines,
+                                      const BIParams& params) {
   params.validate();
-  requireDisparityMap(lines.disparity, "interpolateBetweenScanLines");
-  const ColumnIndex index(lines.disparity);
-  cv::Mat1f out = cv::Mat1f::zeros(lines.disparity.size());
+  requireDisparityMap(lines, "interpolateBetweenScanLines");
+  cv::Mat1f out = cv::Mat1f::zeros(lines.size());
   for (int x = 0; x < index.cols(); ++x) {
     const ColumnEntry* entries = index.column(x);
     const int n = index.size(x);
@@ -229,19 +234,23 @@ cv::Mat1f upsampleBI(const SparseDisparity& sparse, const cv::Mat& image, const 
 }
 
 ScanLineBounds computeScanLineBounds(const ScanLines& lines, double margin_px) {
-  requireDisparityMap(lines.disparity, "computeScanLineBounds");
+  return computeScanLineBounds(ColumnIndex(lines.disparity), lines.disparity, margin_px);
+}
+
+ScanLineBounds computeScanLineBounds(const ColumnIndex& index, const cv::Mat1f& lines,
+                                     double margin_px) {
+  requireDisparityMap(lines, "computeScanLineBounds");
   if (!std::isfinite(margin_px) || margin_px < 0.0) {
     throw std::invalid_argument("computeScanLineBounds: margin_px must be finite and >= 0, got " +
                                 std::to_string(margin_px));
   }
   // Row by row (a column walk writes a cache line per pixel): each column keeps the bounds of the
   // interval it is in, set when the row passes a line; a pixel on a line takes the lines around it.
-  const ColumnIndex index(lines.disparity);
-  const int rows = lines.disparity.rows, cols = lines.disparity.cols;
+  const int rows = lines.rows, cols = lines.cols;
   ScanLineBounds bounds;
-  bounds.lo.create(lines.disparity.size());
-  bounds.hi.create(lines.disparity.size());
-  bounds.range.create(lines.disparity.size());
+  bounds.lo.create(lines.size());
+  bounds.hi.create(lines.size());
+  bounds.range.create(lines.size());
   cv::Mat1f interval = cv::Mat1f::zeros(3, cols);  // lo, hi, range of each column's interval
   std::vector<int> line_index(static_cast<size_t>(cols), 0);  // the column's next line
   const auto set = [margin_px](float d_up, float d_down, float& lo, float& hi, float& range) {
@@ -256,7 +265,7 @@ ScanLineBounds computeScanLineBounds(const ScanLines& lines, double margin_px) {
     std::copy(interval[0], interval[0] + cols, lo);
     std::copy(interval[1], interval[1] + cols, hi);
     std::copy(interval[2], interval[2] + cols, range);
-    const float* on_line = lines.disparity[y];
+    const float* on_line = lines[y];
     for (int x = 0; x < cols; ++x) {
       if (!(on_line[x] > 0.f)) continue;
       const ColumnEntry* e = index.column(x);
