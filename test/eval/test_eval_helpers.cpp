@@ -6,19 +6,13 @@
 #include "lidar_stereo_fusion/eval/pseudo_lidar.h"
 #include "lidar_stereo_fusion/eval/report.h"
 
+#include "eval_test_scenes.h"
+
 namespace lidar_stereo_fusion {
 namespace {
 
-StereoCamera camera() {
-  StereoCamera c;
-  c.fx = c.fy = 100.0;
-  c.cx = 10.0;
-  c.cy = 5.0;
-  c.baseline = 0.5;
-  c.width = 20;
-  c.height = 10;
-  return c;
-}
+/// 20 x 10, fx 100, principal point (10, 5), baseline 0.5 m (eval_test_scenes.h).
+StereoCamera camera() { return test::camera(20, 10); }
 
 LidarPoint point(float x, float y, float z, int ring) {
   LidarPoint p;
