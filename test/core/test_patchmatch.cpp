@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "lidar_stereo_fusion/core/patchmatch.h"
+#include "lidar_stereo_fusion/core/patchmatch/coarse_to_fine.h"
 #include "test_scenes.h"
 
 namespace lsf = lidar_stereo_fusion;
@@ -181,6 +182,38 @@ TEST(PatchMatch, DeterministicForSeedAndThreadCount) {
         lsf::PatchMatchStereo(p).compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}});
     EXPECT_EQ(cv::norm(a.disparity, b.disparity, cv::NORM_INF), 0.0) << "live " << live;
   }
+}
+
+TEST(PatchMatch, SearchScale2EndsWithTheSubpixelStepAtHalfSize) {
+  // The finest level that searches polishes its planes with the sub-pixel step: full size, or
+  // with search_scale 2 (the live preset) the 1/2-size level, whose planes full size up-samples.
+  lsf::PatchMatchParams p;
+  EXPECT_FALSE(lsf::patchmatch::coarseParams(p).fine_subpixel);  // full size searches
+  p.search_scale = 2;
+  const lsf::PatchMatchParams half = lsf::patchmatch::coarseParams(p);
+  EXPECT_TRUE(half.fine_subpixel);
+  EXPECT_FALSE(lsf::patchmatch::coarseParams(half).fine_subpixel);  // the 1/4 level refines
+  p.fine_subpixel = false;
+  EXPECT_FALSE(lsf::patchmatch::coarseParams(p).fine_subpixel);
+  // Stereo only, slanted planes: the step makes the up-sampled planes more precise, in sum over
+  // 12 scenes (0.88x the error without it; single scenes 0.65-1.08x).
+  double error[2] = {0.0, 0.0};
+  for (const uint64_t seed : {1, 2, 3, 4, 5, 6}) {
+    for (const double c : {6.3, 9.1}) {
+      const PlaneScene s = PlaneScene::make(128, 64, 0.05, 0.02, c, seed);
+      for (const bool subpixel : {false, true}) {
+        lsf::PatchMatchParams q = stereoOnly();
+        q.search_scale = 2;
+        q.max_disparity = 16;
+        q.fine_subpixel = subpixel;
+        q.num_threads = 1;
+        const auto r =
+            lsf::PatchMatchStereo(q).compute({s.left, cv::Mat1f(), {}}, {s.right, cv::Mat1f(), {}});
+        error[subpixel] += meanError(r.disparity, s, 12);
+      }
+    }
+  }
+  EXPECT_LT(error[1], 0.93 * error[0]) << error[1] << " against " << error[0];
 }
 
 TEST(PatchMatch, RejectsBadInput) {

@@ -251,8 +251,8 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
               g,
               {},
               "",
-              "Full size after the coarse start: sub-pixel step on d ending the left view's "
-              "search"},
+              "The finest level that searches (full size, or 1/search_scale) after the coarse "
+              "start: sub-pixel step on d ending the left view's search"},
     p.fine_subpixel);
   v(ParamSpec{"fine_refine",
               g,

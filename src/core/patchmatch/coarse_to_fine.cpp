@@ -82,7 +82,10 @@ PatchMatchParams coarseParams(const PatchMatchParams& p) {
   c.unbounded_scale = std::max(1, p.unbounded_scale / s);
   c.full_size_unbounded = true;
   c.fine_right_view = true;
-  c.fine_subpixel = false;  // ... and the sub-pixel step belongs to the full size
+  // ... and the sub-pixel step belongs to the finest level that searches: full size, or with
+  // search_scale > 1 this level when it is 1 / search_scale (it then ends `live`'s search, which
+  // otherwise kept the 1/4 level's precision above the LiDAR: Middlebury lower 2/3 -7 % MAE).
+  c.fine_subpixel = p.fine_subpixel && p.search_scale == s;
   return c;
 }
 

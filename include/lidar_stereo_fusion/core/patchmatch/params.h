@@ -143,7 +143,8 @@ struct PatchMatchParams {
   /// (a fifth of the time; KITTI and Middlebury within 2 % either way).
   /// true: against a full-size right view swept by propagation alone.
   bool fine_lr_check = false;
-  /// Full-size level of a coarse start only: a sub-pixel step on the left view's d
+  /// The finest level that searches after a coarse start (full size, or the 1/search_scale level
+  /// when search_scale > 1) only: a sub-pixel step on the left view's d
   /// (patchmatch/propagation.h), after the random refinement if fine_refine; random refinement
   /// alone would need more candidates for the same precision (synthetic planes: 0.045 px mean
   /// error with the step, 0.055 px without).

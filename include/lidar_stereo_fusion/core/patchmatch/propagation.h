@@ -5,10 +5,11 @@
 // Readings taken here:
 //  * A plane is accepted for pixel p only if its disparity at p lies in [lo(p), hi(p)] from the
 //    scan lines above and below (plus bound_margin), and always in [d_min, d_max] of the image.
-//  * At the full-size level after a coarse start, the left view polishes each plane with a
-//    sub-pixel step (subpixelStep), after a random refinement only if fine_refine, and the right
-//    view, if searched at all (fine_lr_check), by propagation only (PatchMatchParams::
-//    fine_subpixel, fine_refine, fine_right_view, fine_lr_check).
+//  * At the finest level that searches after a coarse start (full size, or 1/search_scale), the
+//    left view polishes each plane with a sub-pixel step (subpixelStep), after a random
+//    refinement only if fine_refine; at full size the right view, if searched at all
+//    (fine_lr_check), by propagation only (PatchMatchParams::fine_subpixel, fine_refine,
+//    fine_right_view, fine_lr_check).
 //  * Refinement starts from Delta_d_max = max(|d_up - d_down|, min_refine_range) between scan
 //    lines (else half the image's disparity range), Delta_n_max = 1; both halve until
 //    Delta_d_max < 0.1 px. At a level that starts from the planes of a coarser one (coarse
