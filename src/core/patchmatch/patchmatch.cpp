@@ -304,8 +304,12 @@ void PatchMatchStereo::searchOptions(const Level& level, patchmatch::SearchOptio
   // An intermediate level (1/2 size of three) refines its right view only with
   // intermediate_refine; else both views only propagate there.
   if (level.guided && intermediate_ && !p.intermediate_refine) right.refine = false;
-  // Swept by propagation alone, the right view serves the left-right check only.
-  if (!right.refine) right.tolerance = 0.25f * static_cast<float>(p.lr_max_diff);
+  // Swept by propagation alone, the right view serves the left-right check only: a candidate
+  // within half the check's threshold of its plane is not tried. (A quarter: `live`'s 1/2 right
+  // sweep 13 % slower, every protocol the same within 0.002 px and 2 mm over four seeds; the
+  // whole threshold: 27 % faster than a quarter, but a plain scene's check flags 5x as many
+  // visible pixels.)
+  if (!right.refine) right.tolerance = 0.5f * static_cast<float>(p.lr_max_diff);
 }
 
 void PatchMatchStereo::searchRightView(const Level& level, const patchmatch::PlaneSearch& left,
