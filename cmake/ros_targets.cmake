@@ -23,6 +23,7 @@ add_library(${PROJECT_NAME}_ros
   src/ros/input_watch.cpp
   src/ros/frame_input.cpp
   src/ros/output_publisher.cpp
+  src/ros/rate_governor.cpp
   src/ros/fusion_worker.cpp
   src/ros/fusion_nodelet.cpp)
 target_include_directories(${PROJECT_NAME}_ros PUBLIC

@@ -27,7 +27,8 @@ catkin_add_gtest(test_ros_unit test/ros/test_conversions_images.cpp
   test/ros/test_point_time.cpp
   test/ros/test_node_parts.cpp test/ros/test_launch_files.cpp test/ros/run_command.cpp
   test/ros/test_pcl_boundary.cpp
-  test/ros/test_recordings_node_unit.cpp)
+  test/ros/test_recordings_node_unit.cpp
+  test/ros/test_rate_governor.cpp)
 if(TARGET test_ros_unit)
   # PCL and pcl_conversions: test_pcl_boundary.cpp shows what PCL's conversion does not check.
   target_link_libraries(test_ros_unit ${PROJECT_NAME}_ros ${GTEST_MAIN_LIBRARIES} pcl_common)
@@ -62,6 +63,7 @@ add_rostest(test/ros/fusion_nodelet.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_node.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_approx_sync.test DEPENDENCIES test_fusion_node)
 add_rostest(test/ros/fusion_max_rate.test DEPENDENCIES test_fusion_node)
+add_rostest(test/ros/fusion_keep_rate.test DEPENDENCIES test_fusion_node)
 
 # Issue 23: a moving rig's bag (ego-motion on /tf) through the nodelet with and without
 # ~fixed_frame, scored against the exact depth at the image instant.

@@ -146,6 +146,8 @@ void FusionWorker::workerLoop() {
     params_changed_ = false;
   }
   FusionPipeline pipeline(params);
+  RateGovernor governor(params.patchmatch);
+  governor_dropped_ = counters_.dropped;
   while (true) {
     // 20 ms: how often sets that waited ~max_sweep_wait are decided, and stop() noticed.
     boost::optional<InputMatch> job = gate_.next(std::chrono::milliseconds(20));
@@ -155,13 +157,22 @@ void FusionWorker::workerLoop() {
       std::lock_guard<std::mutex> lock(params_mutex_);
       if (params_changed_) {
         pipeline.setParams(params_);  // validated in reconfigureCb
+        if (governor.step() > 0) outputs_.setSearchEffort(false, "as configured");
+        governor.rebase(params_.patchmatch);  // the new search, from its first step
         frame_node_ = live_node_;
         outputs_.setLiveParams(frame_node_);
         params_changed_ = false;
       }
     }
     try {
+      const auto start = std::chrono::steady_clock::now();
+      const uint32_t processed = counters_.processed;
       processMatch(*job, pipeline);
+      if (frame_node_.keep_rate && counters_.processed != processed) {
+        const std::chrono::duration<double, std::milli> busy =
+            std::chrono::steady_clock::now() - start;
+        keepRate(governor, pipeline, *job, busy.count());
+      }
     } catch (const std::exception& e) {  // last line of defence: the worker thread must not die
       ++counters_.errors;
       log_.log(
@@ -197,6 +208,30 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
   frame.report.method = methodName(pipeline.params().method);
   outputs_.publish(match, frame.input.camera, frame.input.left, result, pipeline.params(),
                    frame.report);
+}
+
+void FusionWorker::keepRate(RateGovernor& governor, FusionPipeline& pipeline,
+                            const InputMatch& match, double busy_ms) {
+  const uint32_t dropped = counters_.dropped;
+  const uint32_t new_drops = dropped - governor_dropped_;
+  governor_dropped_ = dropped;
+  const int before = governor.step();
+  if (!governor.observe(new_drops, match.image_stamp.toSec(), busy_ms)) return;
+  FusionParams params = pipeline.params();
+  params.patchmatch = governor.params();
+  pipeline.setParams(params);
+  const bool reduced = governor.step() > 0;
+  const std::string effort = governor.current().describe() + " (step " +
+                             std::to_string(governor.step()) + " of " +
+                             std::to_string(governor.steps() - 1) + ")";
+  outputs_.setSearchEffort(reduced, effort);
+  const std::string text = "keep_rate: " + governor.reason() + "; from now on " + effort +
+                           (reduced ? " (set keep_rate false to keep the configured search)" : "");
+  if (governor.step() > before) {
+    ROS_WARN_STREAM("[" << name_ << "] " << text);
+  } else {
+    ROS_INFO_STREAM("[" << name_ << "] " << text);
+  }
 }
 
 bool FusionWorker::lookupExtrinsics(const InputMatch& match, Eigen::Isometry3d& T_cam_lidar) {

@@ -278,13 +278,23 @@ void OutputPublisher::diagnoseOutput(diagnostic_updater::DiagnosticStatusWrapper
   for (const auto& kv : stamps.values) stat.add(kv.key, kv.value);
 }
 
+void OutputPublisher::setSearchEffort(bool reduced, const std::string& text) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  effort_reduced_ = reduced;
+  effort_text_ = text;
+}
+
 void OutputPublisher::diagnoseProcessing(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   double mean_ms = 0, max_ms = 0, mean_latency = 0;
   std::size_t n = 0;
   const CounterSnapshot c = counters_.snapshot();
   uint32_t new_problems = 0;
+  bool reduced = false;
+  std::string effort;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    reduced = effort_reduced_;
+    effort = effort_text_;
     n = recent_total_ms_.size();
     if (n > 0) {
       mean_ms = std::accumulate(recent_total_ms_.begin(), recent_total_ms_.end(), 0.0) / n;
@@ -298,9 +308,13 @@ void OutputPublisher::diagnoseProcessing(diagnostic_updater::DiagnosticStatusWra
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
                   "%u input sets skipped or dropped since the last report (see the counters)",
                   new_problems);
+  } else if (reduced) {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                 "search reduced to keep the input's rate (keep_rate): " + effort);
   } else {
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "ok");
   }
+  stat.add("search effort", effort);
   stat.add("processing time mean [ms]", mean_ms);
   stat.add("processing time max [ms]", max_ms);
   stat.add("latency mean [ms]", mean_latency);

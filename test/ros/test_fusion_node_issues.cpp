@@ -215,3 +215,28 @@ TEST_F(FusionNode, InvalidPointsOfAValidSweepAreCounted) {
   EXPECT_EQ(h().stats()->points_invalid, 3);
   EXPECT_EQ(h().stats()->points_in_cloud, static_cast<int>(base->width * base->height) - 3);
 }
+
+// Only in fusion_keep_rate.test (~keep_rate true, the default preset): sets arriving faster than
+// the worker finishes them are dropped, and the search gives up effort above the LiDAR, saying
+// why; the outputs go on.
+TEST_F(FusionNode, KeepRate_DroppedSetsMakeTheSearchCoarserAndTheNodeSaysWhy) {
+  const std::size_t mark = h().logMark();
+  const uint32_t dropped = h().stats() ? h().stats()->dropped_frames : 0;
+  bool said = false;
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(60.0);
+  ros::Time last;
+  while (!said && ros::WallTime::now() < deadline) {
+    // A burst of sets 1 ms apart: the worker is busy with one while the next ones come.
+    for (int k = 0; k < 10; ++k) {
+      last = h().nextStamp();
+      h().publishSet(SetSpec(), last);
+      ros::WallDuration(0.001).sleep();
+    }
+    h().waitForOutputs(last, 5.0);
+    said = h().waitForLog(mark, {"keep_rate", "dropped input sets", "step 1 of 3"}, 0.5);
+  }
+  ASSERT_TRUE(said) << h().logsSince(mark);
+  ASSERT_TRUE(h().stats());
+  EXPECT_GT(h().stats()->dropped_frames, dropped);
+  expectStillProducing("the search reduced by keep_rate");
+}

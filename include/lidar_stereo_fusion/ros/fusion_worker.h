@@ -33,6 +33,7 @@
 #include "lidar_stereo_fusion/ros/input_gate.h"
 #include "lidar_stereo_fusion/ros/node_support.h"
 #include "lidar_stereo_fusion/ros/output_publisher.h"
+#include "lidar_stereo_fusion/ros/rate_governor.h"
 
 namespace lidar_stereo_fusion {
 
@@ -50,6 +51,10 @@ class FusionWorker {
   /// The frame path of one matched set: extrinsics from TF, prepareFusionInput (frame_input.h),
   /// the core pipeline, the outputs.
   void processMatch(const InputMatch& match, FusionPipeline& pipeline);
+  /// keep_rate: the governor's view of the frame just processed (`busy_ms` the worker's time on
+  /// it); applies and reports a change of the search effort.
+  void keepRate(RateGovernor& governor, FusionPipeline& pipeline, const InputMatch& match,
+                double busy_ms);
   /// LiDAR -> camera at extrinsicsStamp(), waiting up to ~tf_timeout. On a failure: counted,
   /// warned and false (the frame is skipped).
   bool lookupExtrinsics(const InputMatch& match, Eigen::Isometry3d& T_cam_lidar);
@@ -71,6 +76,7 @@ class FusionWorker {
   InputGate gate_;
   OutputPublisher outputs_;
   std::string mixed_encodings_said_;  ///< the last mixed-encoding note logged (worker thread)
+  uint32_t governor_dropped_ = 0;     ///< counters_.dropped when the governor last looked
 
   // TF (own listener thread).
   tf2_ros::Buffer tf_buffer_;

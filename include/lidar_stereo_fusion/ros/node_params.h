@@ -25,6 +25,7 @@ struct NodeParams {
   int sweep_buffer_size = 10;
   double max_rate = 0.0;     ///< [Hz] 0 = no limit (dropped sets: FusionStats.rate_limited)
   double fresh_wait = 0.05;  ///< [s] FreshWait; 0 = always the newest waiting set at once
+  bool keep_rate = false;    ///< rate_governor.h
   double tf_timeout = 0.05;  ///< [s] worker thread only
   std::string fixed_frame;   ///< ego-motion compensation through this frame; empty = off
   int motion_samples = 5;
@@ -88,6 +89,17 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, NodeParams>> visitParams(P&& p,
               "off)",
               "", kStartup},
     p.fresh_wait);
+  v(ParamSpec{"keep_rate",
+              g,
+              {},
+              "",
+              "When input sets are dropped because the worker is busy, search less above the "
+              "LiDAR (pixels without scan-line bounds at a coarser level, then one coarse sweep) "
+              "until the frames fit the input's rate again; warned and in diagnostics (true in "
+              "fusion.launch with preset:=live)",
+              "",
+              kStartup},
+    p.keep_rate);
   g = "motion";
   v(ParamSpec{"tf_timeout", g, within(0, 10), "s",
               "LiDAR -> camera (and ego-motion) TF lookup timeout; the frame is skipped after it"},

@@ -74,6 +74,9 @@ class OutputPublisher {
   /// Takes the live output parameters (cloud_stride, max_output_depth, depth_color_max) from
   /// `params`; call from the thread that publishes, between frames.
   void setLiveParams(const NodeParams& params);
+  /// The search effort in force for the processing diagnostics (keep_rate, rate_governor.h):
+  /// `reduced` (a warning while it lasts) and what it is.
+  void setSearchEffort(bool reduced, const std::string& text);
   /// Publishes the outputs of one frame to the outputs that have subscribers.
   void publish(const InputMatch& match, const StereoCamera& camera, const cv::Mat& left_image,
                const FusionResult& result, const FusionParams& params, const FrameReport& report);
@@ -124,6 +127,8 @@ class OutputPublisher {
   bool shut_down_ = false;
   std::deque<double> recent_total_ms_, recent_latency_ms_;
   uint32_t diag_last_problems_ = 0;
+  bool effort_reduced_ = false;
+  std::string effort_text_ = "as configured";
   uint32_t diag_clock_epoch_ = 0;  ///< diagnostics thread only
 };
 

@@ -1,0 +1,84 @@
+// The node's rate keeper (node parameter keep_rate). On a host too slow for the preset the worker
+// is still busy when the next input set arrives, and sets are dropped (FusionStats.dropped): the
+// node publishes every second sweep. The governor then gives up search where the LiDAR has
+// nothing, one step at a time, and takes the steps back once the frames would fit again.
+//
+// Why there: most of PatchMatch's cost evaluations on a KITTI frame go to pixels without
+// scan-line bounds, above the LiDAR's top beam; inside the LiDAR's view the prior leads and the
+// results hardly change (figures: doc/performance.md, "keep_rate"). The steps:
+//   1. pixels without bounds are searched no finer than the next coarser level (unbounded_scale
+//      times coarse_scale), repeated up to the coarsest level;
+//   2. the coarsest level sweeps the left view once (iterations 1).
+//
+// ROS-free (test/ros/test_rate_governor.cpp); the worker (fusion_worker.cpp) feeds it once per
+// processed frame and applies params().
+#pragma once
+
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "lidar_stereo_fusion/core/patchmatch/params.h"
+
+namespace lidar_stereo_fusion {
+
+/// One step of search effort: what PatchMatch runs with.
+struct EffortStep {
+  int unbounded_scale = 1;  ///< the finest level searching pixels without scan-line bounds
+  int iterations = 1;       ///< sweeps of the coarsest level
+  /// E.g. "pixels without scan-line bounds searched down to 1/4 size, 2 sweeps at the coarsest".
+  std::string describe() const;
+};
+
+/// The steps for `base`: its own search first (pixels without bounds searched down to the finer
+/// of unbounded_scale and search_scale), then unbounded_scale times coarse_scale up to the
+/// coarsest level (coarse_scale^coarse_levels), then one sweep at the coarsest level if `base`
+/// has more. A base without coarse levels, or already at the last step, has one step.
+std::vector<EffortStep> effortSteps(const PatchMatchParams& base);
+
+class RateGovernor {
+ public:
+  static constexpr int kWindow = 10;        ///< frames judged together
+  static constexpr int kLateFrames = 2;     ///< frames of a window followed by drops: step down
+  static constexpr int kCalmFrames = 100;   ///< frames in a row without drops before a step up
+  static constexpr double kHeadroom = 0.8;  ///< step up when predicted <= this share of a period
+
+  explicit RateGovernor(const PatchMatchParams& base) { rebase(base); }
+
+  /// After each processed frame: `dropped` input sets dropped since the previous call (the worker
+  /// was busy when a newer one came), the frame's image `stamp` [s] and the worker's time on it
+  /// `busy_ms`. Returns true when the step changed; params() is then what the next frame uses
+  /// and reason() says why.
+  bool observe(unsigned dropped, double stamp, double busy_ms);
+
+  /// The configured parameters with the current step's search (at the first step, as configured).
+  PatchMatchParams params() const;
+  /// The parameters changed (dynamic_reconfigure): the steps follow them, from the first.
+  void rebase(const PatchMatchParams& base);
+
+  int step() const { return step_; }
+  int steps() const { return static_cast<int>(steps_.size()); }
+  const EffortStep& current() const { return steps_[static_cast<size_t>(step_)]; }
+  const std::string& reason() const { return reason_; }
+  /// The time between input sets [s] seen between two frames with no drop between them (the
+  /// median of the last kWindow such), or 0 before there is one.
+  double period() const;
+
+ private:
+  void changeStep(int step, const std::string& why);
+  static double median(std::vector<double> v);
+
+  PatchMatchParams base_;
+  std::vector<EffortStep> steps_;
+  int step_ = 0;
+  std::deque<bool> late_;        ///< the last kWindow frames at this step: followed by drops
+  std::deque<double> busy_;      ///< their busy times [ms]
+  std::deque<double> periods_;   ///< intervals [s] between frames without a drop between them
+  std::vector<double> leaving_;  ///< per step: median busy time when it was left for the next
+  std::vector<double> arrived_;  ///< per step: median busy time of its first window
+  int calm_ = 0;                 ///< frames in a row without drops at this step
+  double last_stamp_ = -1.0;
+  std::string reason_;
+};
+
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,127 @@
+#include "lidar_stereo_fusion/ros/rate_governor.h"
+
+#include <algorithm>
+#include <sstream>
+
+namespace lidar_stereo_fusion {
+
+namespace {
+
+std::string sizeText(int scale) { return scale == 1 ? "full size" : "1/" + std::to_string(scale) + " size"; }
+
+std::string msText(double ms) { return std::to_string(static_cast<int>(ms + 0.5)) + " ms"; }
+
+}  // namespace
+
+std::string EffortStep::describe() const {
+  return "pixels without scan-line bounds searched down to " + sizeText(unbounded_scale) + ", " +
+         std::to_string(iterations) + (iterations == 1 ? " sweep" : " sweeps") +
+         " at the coarsest level";
+}
+
+std::vector<EffortStep> effortSteps(const PatchMatchParams& base) {
+  // Pixels without bounds are searched no finer than the finest level that searches at all.
+  std::vector<EffortStep> steps{
+      EffortStep{std::max(base.unbounded_scale, base.search_scale), base.iterations}};
+  if (base.coarse_levels < 1 || base.coarse_scale < 2) return steps;
+  int coarsest = 1;
+  for (int k = 0; k < base.coarse_levels; ++k) coarsest *= base.coarse_scale;
+  EffortStep s = steps.back();
+  while (s.unbounded_scale < coarsest) {
+    s.unbounded_scale *= base.coarse_scale;
+    steps.push_back(s);
+  }
+  if (s.iterations > 1) {
+    s.iterations = 1;
+    steps.push_back(s);
+  }
+  return steps;
+}
+
+void RateGovernor::rebase(const PatchMatchParams& base) {
+  base_ = base;
+  steps_ = effortSteps(base);
+  leaving_.assign(steps_.size(), 0.0);
+  arrived_.assign(steps_.size(), 0.0);
+  step_ = 0;
+  late_.clear();
+  busy_.clear();
+  calm_ = 0;
+  reason_.clear();
+}
+
+PatchMatchParams RateGovernor::params() const {
+  if (step_ == 0) return base_;
+  PatchMatchParams p = base_;
+  p.unbounded_scale = current().unbounded_scale;
+  p.iterations = current().iterations;
+  return p;
+}
+
+double RateGovernor::median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+double RateGovernor::period() const { return median({periods_.begin(), periods_.end()}); }
+
+void RateGovernor::changeStep(int step, const std::string& why) {
+  step_ = step;
+  late_.clear();
+  busy_.clear();
+  calm_ = 0;
+  reason_ = why;
+}
+
+bool RateGovernor::observe(unsigned dropped, double stamp, double busy_ms) {
+  const bool late = dropped > 0;
+  // Two frames with no set dropped between them are one input period apart (a stamp going back
+  // is a restart: no interval).
+  if (!late && last_stamp_ >= 0.0 && stamp > last_stamp_) {
+    periods_.push_back(stamp - last_stamp_);
+    if (static_cast<int>(periods_.size()) > kWindow) periods_.pop_front();
+  }
+  last_stamp_ = stamp;
+  late_.push_back(late);
+  busy_.push_back(busy_ms);
+  if (static_cast<int>(late_.size()) > kWindow) {
+    late_.pop_front();
+    busy_.pop_front();
+  }
+  calm_ = late ? 0 : calm_ + 1;
+  if (static_cast<int>(late_.size()) < kWindow) return false;
+  const double busy = median({busy_.begin(), busy_.end()});
+  const size_t s = static_cast<size_t>(step_);
+  if (arrived_[s] == 0.0) arrived_[s] = busy;
+  const int lates = static_cast<int>(std::count(late_.begin(), late_.end(), true));
+  if (lates >= kLateFrames && step_ + 1 < steps()) {
+    leaving_[s] = busy;
+    std::ostringstream why;
+    why << lates << " of the last " << kWindow << " frames were followed by dropped input sets "
+        << "(frames take " << msText(busy) << ", median";
+    if (period() > 0.0) why << ", input every " << msText(1000.0 * period());
+    why << ")";
+    arrived_[s + 1] = 0.0;
+    changeStep(step_ + 1, why.str());
+    return true;
+  }
+  // A step up when the finer step, scaled by how much slower it was than this one when both
+  // were measured, would take at most kHeadroom of a period (the host may have calmed down).
+  if (step_ > 0 && calm_ >= kCalmFrames && period() > 0.0 && arrived_[s] > 0.0 &&
+      leaving_[s - 1] > 0.0) {
+    const double predicted = busy * leaving_[s - 1] / arrived_[s];
+    if (predicted <= kHeadroom * 1000.0 * period()) {
+      std::ostringstream why;
+      why << "no input set dropped in " << calm_ << " frames (frames take " << msText(busy)
+          << ", median; the finer step is predicted at " << msText(predicted) << ", input every "
+          << msText(1000.0 * period()) << ")";
+      changeStep(step_ - 1, why.str());
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace lidar_stereo_fusion

@@ -1,0 +1,151 @@
+// RateGovernor (ros/rate_governor.h): the steps of search effort and when it takes them.
+#include <gtest/gtest.h>
+
+#include "lidar_stereo_fusion/ros/rate_governor.h"
+
+namespace lsf = lidar_stereo_fusion;
+
+namespace {
+
+/// The live preset's search (config/live.yaml): two coarse levels of factor 2, pixels without
+/// bounds searched down to 1/2 size, two sweeps at 1/4.
+lsf::PatchMatchParams livePreset() {
+  lsf::PatchMatchParams p;
+  p.coarse_scale = 2;
+  p.coarse_levels = 2;
+  p.search_scale = 2;
+  p.unbounded_scale = 1;  // config/live.yaml keeps the default: search_scale 2 bounds it
+  p.iterations = 2;
+  return p;
+}
+
+/// Feeds `n` frames `period` s apart from `t` (advanced), each followed by `dropped` drops every
+/// `every`-th frame; returns how many calls changed the step.
+int feed(lsf::RateGovernor& g, double& t, int n, double period, double busy_ms, int every,
+         unsigned dropped = 1) {
+  int changes = 0;
+  for (int i = 0; i < n; ++i) {
+    const bool late = every > 0 && i % every == every - 1;
+    t += late ? 2 * period : period;
+    changes += g.observe(late ? dropped : 0u, t, busy_ms) ? 1 : 0;
+  }
+  return changes;
+}
+
+}  // namespace
+
+TEST(RateGovernor, StepsGoToTheCoarsestLevelThenOneSweep) {
+  const auto live = lsf::effortSteps(livePreset());
+  ASSERT_EQ(live.size(), 3u);
+  EXPECT_EQ(live[0].unbounded_scale, 2);
+  EXPECT_EQ(live[0].iterations, 2);
+  EXPECT_EQ(live[1].unbounded_scale, 4);
+  EXPECT_EQ(live[1].iterations, 2);
+  EXPECT_EQ(live[2].unbounded_scale, 4);
+  EXPECT_EQ(live[2].iterations, 1);
+  EXPECT_EQ(live[1].describe(),
+            "pixels without scan-line bounds searched down to 1/4 size, 2 sweeps at the coarsest "
+            "level");
+
+  lsf::PatchMatchParams fusion = livePreset();  // the default preset: every level searches
+  fusion.search_scale = 1;
+  fusion.unbounded_scale = 1;
+  EXPECT_EQ(lsf::effortSteps(fusion).size(), 4u);  // 1, 2, 4, then one sweep
+
+  lsf::PatchMatchParams flat;  // no coarse level (plain PMS): nothing to give up
+  flat.coarse_levels = 0;
+  flat.coarse_scale = 1;
+  EXPECT_EQ(lsf::effortSteps(flat).size(), 1u);
+}
+
+TEST(RateGovernor, KeepsTheSearchWhileNoSetIsDropped) {
+  lsf::RateGovernor g(livePreset());
+  double t = 0;
+  EXPECT_EQ(feed(g, t, 500, 0.1, 95.0, 0), 0);
+  EXPECT_EQ(g.step(), 0);
+  EXPECT_NEAR(g.period(), 0.1, 1e-9);
+  EXPECT_EQ(g.params().unbounded_scale, 1);  // the first step is the configured search itself
+}
+
+TEST(RateGovernor, OneDropInTenFramesIsNoReasonToStep) {
+  lsf::RateGovernor g(livePreset());
+  double t = 0;
+  EXPECT_EQ(feed(g, t, 300, 0.1, 90.0, 10), 0);  // exactly one late frame in every window
+  EXPECT_EQ(g.step(), 0);
+}
+
+TEST(RateGovernor, StepsDownWhenTwoOfTenFramesAreFollowedByDrops) {
+  lsf::RateGovernor g(livePreset());
+  double t = 0;
+  // Every 5th frame late: the 10th frame completes the first window with two late frames.
+  int changes = 0, at = -1;
+  for (int i = 0; i < 10; ++i) {
+    const bool late = i % 5 == 4;
+    t += late ? 0.2 : 0.1;
+    if (g.observe(late ? 1u : 0u, t, 130.0)) {
+      ++changes;
+      at = i;
+    }
+  }
+  EXPECT_EQ(changes, 1);
+  EXPECT_EQ(at, 9);
+  EXPECT_EQ(g.step(), 1);
+  EXPECT_EQ(g.params().unbounded_scale, 4);
+  EXPECT_EQ(g.params().iterations, 2);
+  EXPECT_EQ(g.params().search_scale, 2);  // the rest as configured
+  EXPECT_EQ(g.reason(),
+            "2 of the last 10 frames were followed by dropped input sets (frames take 130 ms, "
+            "median, input every 100 ms)");
+  // Still late at step 1: step 2 after another full window, then no further step exists.
+  EXPECT_EQ(feed(g, t, 10, 0.1, 110.0, 5), 1);
+  EXPECT_EQ(g.step(), 2);
+  EXPECT_EQ(g.params().iterations, 1);
+  EXPECT_EQ(feed(g, t, 50, 0.1, 105.0, 5), 0);
+  EXPECT_EQ(g.step(), 2);
+}
+
+TEST(RateGovernor, StepsBackUpOnlyWhenTheFinerStepIsPredictedToFit) {
+  lsf::RateGovernor g(livePreset());
+  double t = 0;
+  ASSERT_EQ(feed(g, t, 10, 0.1, 130.0, 5), 1);  // left step 0 at 130 ms
+  // Step 1 takes 97 ms: step 0 is predicted at 130 ms, more than 0.8 x 100: it stays.
+  EXPECT_EQ(feed(g, t, 300, 0.1, 97.0, 0), 0);
+  EXPECT_EQ(g.step(), 1);
+  // The host calms down: step 1 now takes 48.5 ms, so step 0 is predicted at 65 ms (<= 80 ms);
+  // the median of the window follows after 6 frames.
+  int changes = 0, at = -1;
+  for (int i = 0; i < 20 && changes == 0; ++i) {
+    t += 0.1;
+    if (g.observe(0u, t, 48.5)) {
+      ++changes;
+      at = i;
+    }
+  }
+  EXPECT_EQ(changes, 1);
+  EXPECT_EQ(at, 5);
+  EXPECT_EQ(g.step(), 0);
+  EXPECT_EQ(g.reason(),
+            "no input set dropped in 306 frames (frames take 49 ms, median; the finer step is "
+            "predicted at 65 ms, input every 100 ms)");
+}
+
+TEST(RateGovernor, ARebaseStartsFromTheNewSearch) {
+  lsf::RateGovernor g(livePreset());
+  double t = 0;
+  ASSERT_EQ(feed(g, t, 10, 0.1, 130.0, 5), 1);
+  lsf::PatchMatchParams changed = livePreset();
+  changed.iterations = 3;
+  g.rebase(changed);
+  EXPECT_EQ(g.step(), 0);
+  EXPECT_EQ(g.params().iterations, 3);
+  EXPECT_EQ(g.steps(), 3);
+}
+
+TEST(RateGovernor, ATimeJumpBackIsNoInterval) {
+  lsf::RateGovernor g(livePreset());
+  g.observe(0u, 100.0, 50.0);
+  g.observe(0u, 100.1, 50.0);
+  g.observe(0u, 5.0, 50.0);  // a bag played again from its start
+  g.observe(0u, 5.1, 50.0);
+  EXPECT_NEAR(g.period(), 0.1, 1e-9);
+}
