@@ -7,7 +7,9 @@ namespace lidar_stereo_fusion {
 
 namespace {
 
-std::string sizeText(int scale) { return scale == 1 ? "full size" : "1/" + std::to_string(scale) + " size"; }
+std::string sizeText(int scale) {
+  return scale == 1 ? "full size" : "1/" + std::to_string(scale) + " size";
+}
 
 std::string msText(double ms) { return std::to_string(static_cast<int>(ms + 0.5)) + " ms"; }
 

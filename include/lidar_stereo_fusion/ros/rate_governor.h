@@ -1,6 +1,6 @@
 // The node's rate keeper (node parameter keep_rate). On a host too slow for the preset the worker
-// is still busy when the next input set arrives, and sets are dropped (FusionStats.dropped_frames): the
-// node publishes every second sweep. The governor then gives up search where the LiDAR has
+// is still busy when the next input set arrives, and sets are dropped (FusionStats.dropped_frames):
+// the node publishes every second sweep. The governor then gives up search where the LiDAR has
 // nothing, one step at a time, and takes the steps back once the frames would fit again.
 //
 // Why there: most of PatchMatch's cost evaluations on a KITTI frame go to pixels without
