@@ -168,7 +168,10 @@ void FusionWorker::workerLoop() {
       const auto start = std::chrono::steady_clock::now();
       const uint32_t processed = counters_.processed;
       processMatch(*job, pipeline);
-      if (frame_node_.keep_rate && counters_.processed != processed) {
+      // Only the fused methods search with scan-line bounds; the others have nothing to give up.
+      const Method method = pipeline.params().method;
+      const bool fused = method == Method::kFusedBI || method == Method::kFusedBF;
+      if (frame_node_.keep_rate && fused && counters_.processed != processed) {
         const std::chrono::duration<double, std::milli> busy =
             std::chrono::steady_clock::now() - start;
         keepRate(governor, pipeline, *job, busy.count());
