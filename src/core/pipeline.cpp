@@ -21,7 +21,6 @@ double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-bool isFused(Method m) { return m == Method::kFusedBI || m == Method::kFusedBF; }
 bool usesLidar(Method m) { return m != Method::kPlainPMS; }
 bool usesPatchMatch(Method m) {
   return m == Method::kFusedBI || m == Method::kFusedBF || m == Method::kPlainPMS;
@@ -107,6 +106,8 @@ std::string methodName(Method method) {
   }
   return "unknown";
 }
+
+bool isFused(Method method) { return method == Method::kFusedBI || method == Method::kFusedBF; }
 
 Method parseMethod(const std::string& name) {
   for (Method m : {Method::kFusedBI, Method::kFusedBF, Method::kPlainPMS, Method::kLidarBI,

@@ -146,7 +146,7 @@ void FusionWorker::workerLoop() {
     params_changed_ = false;
   }
   FusionPipeline pipeline(params);
-  RateGovernor governor(params.patchmatch);
+  RateGovernor governor(params);
   governor_dropped_ = counters_.dropped;
   while (true) {
     // 20 ms: how often sets that waited ~max_sweep_wait are decided, and stop() noticed.
@@ -158,7 +158,7 @@ void FusionWorker::workerLoop() {
       if (params_changed_) {
         pipeline.setParams(params_);  // validated in reconfigureCb
         if (governor.step() > 0) outputs_.setSearchEffort(false, "as configured");
-        governor.rebase(params_.patchmatch);  // the new search, from its first step
+        governor.rebase(params_);  // the new search, from its first step
         frame_node_ = live_node_;
         outputs_.setLiveParams(frame_node_);
         params_changed_ = false;
@@ -168,13 +168,10 @@ void FusionWorker::workerLoop() {
       const auto start = std::chrono::steady_clock::now();
       const uint32_t processed = counters_.processed;
       processMatch(*job, pipeline);
-      // Only the fused methods search with scan-line bounds; the others have nothing to give up.
-      const Method method = pipeline.params().method;
-      const bool fused = method == Method::kFusedBI || method == Method::kFusedBF;
-      if (frame_node_.keep_rate && fused && counters_.processed != processed) {
+      if (frame_node_.keep_rate && counters_.processed != processed) {
         const std::chrono::duration<double, std::milli> busy =
             std::chrono::steady_clock::now() - start;
-        keepRate(governor, pipeline, *job, busy.count());
+        keepRate(governor, pipeline, busy.count());
       }
     } catch (const std::exception& e) {  // last line of defence: the worker thread must not die
       ++counters_.errors;
@@ -213,16 +210,13 @@ void FusionWorker::processMatch(const InputMatch& match, FusionPipeline& pipelin
                    frame.report);
 }
 
-void FusionWorker::keepRate(RateGovernor& governor, FusionPipeline& pipeline,
-                            const InputMatch& match, double busy_ms) {
+void FusionWorker::keepRate(RateGovernor& governor, FusionPipeline& pipeline, double busy_ms) {
   const uint32_t dropped = counters_.dropped;
   const uint32_t new_drops = dropped - governor_dropped_;
   governor_dropped_ = dropped;
   const int before = governor.step();
-  if (!governor.observe(new_drops, match.image_stamp.toSec(), busy_ms)) return;
-  FusionParams params = pipeline.params();
-  params.patchmatch = governor.params();
-  pipeline.setParams(params);
+  if (!governor.observe(new_drops, gate_.inputPeriod(), busy_ms)) return;
+  pipeline.setParams(governor.params());
   const bool reduced = governor.step() > 0;
   const std::string effort = governor.current().describe() + " (step " +
                              std::to_string(governor.step()) + " of " +

@@ -397,4 +397,9 @@ void InputGate::handleEvents(InputMatcher::Events& events, const std::string& to
   ready_cv_.notify_one();
 }
 
+double InputGate::inputPeriod() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return fresh_.period();
+}
+
 }  // namespace lidar_stereo_fusion

@@ -21,16 +21,17 @@ std::string EffortStep::describe() const {
          " at the coarsest level";
 }
 
-std::vector<EffortStep> effortSteps(const PatchMatchParams& base) {
+std::vector<EffortStep> effortSteps(const FusionParams& base) {
+  const PatchMatchParams& p = base.patchmatch;
   // Pixels without bounds are searched no finer than the finest level that searches at all.
   std::vector<EffortStep> steps{
-      EffortStep{std::max(base.unbounded_scale, base.search_scale), base.iterations}};
-  if (base.coarse_levels < 1 || base.coarse_scale < 2) return steps;
+      EffortStep{std::max(p.unbounded_scale, p.search_scale), p.iterations}};
+  if (!isFused(base.method) || p.coarse_levels < 1 || p.coarse_scale < 2) return steps;
   int coarsest = 1;
-  for (int k = 0; k < base.coarse_levels; ++k) coarsest *= base.coarse_scale;
+  for (int k = 0; k < p.coarse_levels; ++k) coarsest *= p.coarse_scale;
   EffortStep s = steps.back();
   while (s.unbounded_scale < coarsest) {
-    s.unbounded_scale *= base.coarse_scale;
+    s.unbounded_scale *= p.coarse_scale;
     steps.push_back(s);
   }
   if (s.iterations > 1) {
@@ -40,23 +41,19 @@ std::vector<EffortStep> effortSteps(const PatchMatchParams& base) {
   return steps;
 }
 
-void RateGovernor::rebase(const PatchMatchParams& base) {
+void RateGovernor::rebase(const FusionParams& base) {
   base_ = base;
   steps_ = effortSteps(base);
   leaving_.assign(steps_.size(), 0.0);
   arrived_.assign(steps_.size(), 0.0);
-  step_ = 0;
-  late_.clear();
-  busy_.clear();
-  calm_ = 0;
-  reason_.clear();
+  changeStep(0, "");
 }
 
-PatchMatchParams RateGovernor::params() const {
+FusionParams RateGovernor::params() const {
   if (step_ == 0) return base_;
-  PatchMatchParams p = base_;
-  p.unbounded_scale = current().unbounded_scale;
-  p.iterations = current().iterations;
+  FusionParams p = base_;
+  p.patchmatch.unbounded_scale = current().unbounded_scale;
+  p.patchmatch.iterations = current().iterations;
   return p;
 }
 
@@ -67,8 +64,6 @@ double RateGovernor::median(std::vector<double> v) {
   return *mid;
 }
 
-double RateGovernor::period() const { return median({periods_.begin(), periods_.end()}); }
-
 void RateGovernor::changeStep(int step, const std::string& why) {
   step_ = step;
   late_.clear();
@@ -77,15 +72,8 @@ void RateGovernor::changeStep(int step, const std::string& why) {
   reason_ = why;
 }
 
-bool RateGovernor::observe(unsigned dropped, double stamp, double busy_ms) {
+bool RateGovernor::observe(unsigned dropped, double period, double busy_ms) {
   const bool late = dropped > 0;
-  // Two frames with no set dropped between them are one input period apart (a stamp going back
-  // is a restart: no interval).
-  if (!late && last_stamp_ >= 0.0 && stamp > last_stamp_) {
-    periods_.push_back(stamp - last_stamp_);
-    if (static_cast<int>(periods_.size()) > kWindow) periods_.pop_front();
-  }
-  last_stamp_ = stamp;
   late_.push_back(late);
   busy_.push_back(busy_ms);
   if (static_cast<int>(late_.size()) > kWindow) {
@@ -103,7 +91,7 @@ bool RateGovernor::observe(unsigned dropped, double stamp, double busy_ms) {
     std::ostringstream why;
     why << lates << " of the last " << kWindow << " frames were followed by dropped input sets "
         << "(frames take " << msText(busy) << ", median";
-    if (period() > 0.0) why << ", input every " << msText(1000.0 * period());
+    if (period > 0.0) why << ", input every " << msText(1000.0 * period);
     why << ")";
     arrived_[s + 1] = 0.0;
     changeStep(step_ + 1, why.str());
@@ -111,14 +99,14 @@ bool RateGovernor::observe(unsigned dropped, double stamp, double busy_ms) {
   }
   // A step up when the finer step, scaled by how much slower it was than this one when both
   // were measured, would take at most kHeadroom of a period (the host may have calmed down).
-  if (step_ > 0 && calm_ >= kCalmFrames && period() > 0.0 && arrived_[s] > 0.0 &&
+  if (step_ > 0 && calm_ >= kCalmFrames && period > 0.0 && arrived_[s] > 0.0 &&
       leaving_[s - 1] > 0.0) {
     const double predicted = busy * leaving_[s - 1] / arrived_[s];
-    if (predicted <= kHeadroom * 1000.0 * period()) {
+    if (predicted <= kHeadroom * 1000.0 * period) {
       std::ostringstream why;
       why << "no input set dropped in " << calm_ << " frames (frames take " << msText(busy)
           << ", median; the finer step is predicted at " << msText(predicted) << ", input every "
-          << msText(1000.0 * period()) << ")";
+          << msText(1000.0 * period) << ")";
       changeStep(step_ - 1, why.str());
       return true;
     }

@@ -9,25 +9,25 @@ namespace {
 
 /// The live preset's search (config/live.yaml): two coarse levels of factor 2, pixels without
 /// bounds searched down to 1/2 size, two sweeps at 1/4.
-lsf::PatchMatchParams livePreset() {
-  lsf::PatchMatchParams p;
+lsf::FusionParams livePreset() {
+  lsf::FusionParams f;  // method fused_bi
+  lsf::PatchMatchParams& p = f.patchmatch;
   p.coarse_scale = 2;
   p.coarse_levels = 2;
   p.search_scale = 2;
   p.unbounded_scale = 1;  // config/live.yaml keeps the default: search_scale 2 bounds it
   p.iterations = 2;
-  return p;
+  return f;
 }
 
-/// Feeds `n` frames `period` s apart from `t` (advanced), each followed by `dropped` drops every
-/// `every`-th frame; returns how many calls changed the step.
-int feed(lsf::RateGovernor& g, double& t, int n, double period, double busy_ms, int every,
+/// Feeds `n` frames with the input `period` [s], each followed by `dropped` drops every `every`-th
+/// frame; returns how many calls changed the step.
+int feed(lsf::RateGovernor& g, int n, double period, double busy_ms, int every,
          unsigned dropped = 1) {
   int changes = 0;
   for (int i = 0; i < n; ++i) {
     const bool late = every > 0 && i % every == every - 1;
-    t += late ? 2 * period : period;
-    changes += g.observe(late ? dropped : 0u, t, busy_ms) ? 1 : 0;
+    changes += g.observe(late ? dropped : 0u, period, busy_ms) ? 1 : 0;
   }
   return changes;
 }
@@ -47,42 +47,45 @@ TEST(RateGovernor, StepsGoToTheCoarsestLevelThenOneSweep) {
             "pixels without scan-line bounds searched down to 1/4 size, 2 sweeps at the coarsest "
             "level");
 
-  lsf::PatchMatchParams fusion = livePreset();  // the default preset: every level searches
-  fusion.search_scale = 1;
-  fusion.unbounded_scale = 1;
+  lsf::FusionParams fusion = livePreset();  // the default preset: every level searches
+  fusion.patchmatch.search_scale = 1;
+  fusion.patchmatch.unbounded_scale = 1;
   EXPECT_EQ(lsf::effortSteps(fusion).size(), 4u);  // 1, 2, 4, then one sweep
 
-  lsf::PatchMatchParams flat;  // no coarse level (plain PMS): nothing to give up
-  flat.coarse_levels = 0;
-  flat.coarse_scale = 1;
+  lsf::FusionParams flat;  // no coarse level: nothing to give up
+  flat.patchmatch.coarse_levels = 0;
+  flat.patchmatch.coarse_scale = 1;
   EXPECT_EQ(lsf::effortSteps(flat).size(), 1u);
+
+  // Not fused (stereo alone, LiDAR alone): no scan-line bounds to search by.
+  for (lsf::Method m : {lsf::Method::kPlainPMS, lsf::Method::kLidarBI, lsf::Method::kLidarBF}) {
+    lsf::FusionParams other = livePreset();
+    other.method = m;
+    EXPECT_EQ(lsf::effortSteps(other).size(), 1u) << lsf::methodName(m);
+  }
 }
 
 TEST(RateGovernor, KeepsTheSearchWhileNoSetIsDropped) {
   lsf::RateGovernor g(livePreset());
-  double t = 0;
-  EXPECT_EQ(feed(g, t, 500, 0.1, 95.0, 0), 0);
+  EXPECT_EQ(feed(g, 500, 0.1, 95.0, 0), 0);
   EXPECT_EQ(g.step(), 0);
-  EXPECT_NEAR(g.period(), 0.1, 1e-9);
-  EXPECT_EQ(g.params().unbounded_scale, 1);  // the first step is the configured search itself
+  EXPECT_EQ(g.params().patchmatch.unbounded_scale,
+            1);  // the first step is the configured search itself
 }
 
 TEST(RateGovernor, OneDropInTenFramesIsNoReasonToStep) {
   lsf::RateGovernor g(livePreset());
-  double t = 0;
-  EXPECT_EQ(feed(g, t, 300, 0.1, 90.0, 10), 0);  // exactly one late frame in every window
+  EXPECT_EQ(feed(g, 300, 0.1, 90.0, 10), 0);  // exactly one late frame in every window
   EXPECT_EQ(g.step(), 0);
 }
 
 TEST(RateGovernor, StepsDownWhenTwoOfTenFramesAreFollowedByDrops) {
   lsf::RateGovernor g(livePreset());
-  double t = 0;
   // Every 5th frame late: the 10th frame completes the first window with two late frames.
   int changes = 0, at = -1;
   for (int i = 0; i < 10; ++i) {
     const bool late = i % 5 == 4;
-    t += late ? 0.2 : 0.1;
-    if (g.observe(late ? 1u : 0u, t, 130.0)) {
+    if (g.observe(late ? 1u : 0u, 0.1, 130.0)) {
       ++changes;
       at = i;
     }
@@ -90,33 +93,31 @@ TEST(RateGovernor, StepsDownWhenTwoOfTenFramesAreFollowedByDrops) {
   EXPECT_EQ(changes, 1);
   EXPECT_EQ(at, 9);
   EXPECT_EQ(g.step(), 1);
-  EXPECT_EQ(g.params().unbounded_scale, 4);
-  EXPECT_EQ(g.params().iterations, 2);
-  EXPECT_EQ(g.params().search_scale, 2);  // the rest as configured
+  EXPECT_EQ(g.params().patchmatch.unbounded_scale, 4);
+  EXPECT_EQ(g.params().patchmatch.iterations, 2);
+  EXPECT_EQ(g.params().patchmatch.search_scale, 2);  // the rest as configured
   EXPECT_EQ(g.reason(),
             "2 of the last 10 frames were followed by dropped input sets (frames take 130 ms, "
             "median, input every 100 ms)");
   // Still late at step 1: step 2 after another full window, then no further step exists.
-  EXPECT_EQ(feed(g, t, 10, 0.1, 110.0, 5), 1);
+  EXPECT_EQ(feed(g, 10, 0.1, 110.0, 5), 1);
   EXPECT_EQ(g.step(), 2);
-  EXPECT_EQ(g.params().iterations, 1);
-  EXPECT_EQ(feed(g, t, 50, 0.1, 105.0, 5), 0);
+  EXPECT_EQ(g.params().patchmatch.iterations, 1);
+  EXPECT_EQ(feed(g, 50, 0.1, 105.0, 5), 0);
   EXPECT_EQ(g.step(), 2);
 }
 
 TEST(RateGovernor, StepsBackUpOnlyWhenTheFinerStepIsPredictedToFit) {
   lsf::RateGovernor g(livePreset());
-  double t = 0;
-  ASSERT_EQ(feed(g, t, 10, 0.1, 130.0, 5), 1);  // left step 0 at 130 ms
+  ASSERT_EQ(feed(g, 10, 0.1, 130.0, 5), 1);  // left step 0 at 130 ms
   // Step 1 takes 97 ms: step 0 is predicted at 130 ms, more than 0.8 x 100: it stays.
-  EXPECT_EQ(feed(g, t, 300, 0.1, 97.0, 0), 0);
+  EXPECT_EQ(feed(g, 300, 0.1, 97.0, 0), 0);
   EXPECT_EQ(g.step(), 1);
   // The host calms down: step 1 now takes 48.5 ms, so step 0 is predicted at 65 ms (<= 80 ms);
   // the median of the window follows after 6 frames.
   int changes = 0, at = -1;
   for (int i = 0; i < 20 && changes == 0; ++i) {
-    t += 0.1;
-    if (g.observe(0u, t, 48.5)) {
+    if (g.observe(0u, 0.1, 48.5)) {
       ++changes;
       at = i;
     }
@@ -131,21 +132,26 @@ TEST(RateGovernor, StepsBackUpOnlyWhenTheFinerStepIsPredictedToFit) {
 
 TEST(RateGovernor, ARebaseStartsFromTheNewSearch) {
   lsf::RateGovernor g(livePreset());
-  double t = 0;
-  ASSERT_EQ(feed(g, t, 10, 0.1, 130.0, 5), 1);
-  lsf::PatchMatchParams changed = livePreset();
-  changed.iterations = 3;
+  ASSERT_EQ(feed(g, 10, 0.1, 130.0, 5), 1);
+  lsf::FusionParams changed = livePreset();
+  changed.patchmatch.iterations = 3;
   g.rebase(changed);
   EXPECT_EQ(g.step(), 0);
-  EXPECT_EQ(g.params().iterations, 3);
+  EXPECT_EQ(g.params().patchmatch.iterations, 3);
   EXPECT_EQ(g.steps(), 3);
 }
 
-TEST(RateGovernor, ATimeJumpBackIsNoInterval) {
+TEST(RateGovernor, AnUnknownPeriodStepsDownButNeverUp) {
+  // The period is InputGate's (FreshWait: the median interval of the sets; 0 until three are
+  // known, and after a time jump back).
   lsf::RateGovernor g(livePreset());
-  g.observe(0u, 100.0, 50.0);
-  g.observe(0u, 100.1, 50.0);
-  g.observe(0u, 5.0, 50.0);  // a bag played again from its start
-  g.observe(0u, 5.1, 50.0);
-  EXPECT_NEAR(g.period(), 0.1, 1e-9);
+  ASSERT_EQ(feed(g, 10, 0.0, 130.0, 5), 1);
+  EXPECT_EQ(g.reason(),
+            "2 of the last 10 frames were followed by dropped input sets (frames take 130 ms, "
+            "median)");
+  EXPECT_EQ(feed(g, 10, 0.0, 97.0, 0), 0);   // step 1's first window: 97 ms
+  EXPECT_EQ(feed(g, 300, 0.0, 20.0, 0), 0);  // step 0 predicted at 27 ms, but no period known
+  EXPECT_EQ(g.step(), 1);
+  EXPECT_EQ(feed(g, 1, 0.1, 20.0, 0), 1);  // a period again: 27 <= 80 ms, back up
+  EXPECT_EQ(g.step(), 0);
 }

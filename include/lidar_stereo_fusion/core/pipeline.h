@@ -26,6 +26,8 @@ enum class Method {
 std::string methodName(Method method);
 /// Parses the names above; throws std::invalid_argument listing the valid names.
 Method parseMethod(const std::string& name);
+/// fused_bi or fused_bf: the LiDAR's prior guides PatchMatch (scan-line bounds, confidence).
+bool isFused(Method method);
 
 struct FusionParams {
   Method method = Method::kFusedBI;

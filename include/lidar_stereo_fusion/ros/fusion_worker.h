@@ -53,8 +53,7 @@ class FusionWorker {
   void processMatch(const InputMatch& match, FusionPipeline& pipeline);
   /// keep_rate: the governor's view of the frame just processed (`busy_ms` the worker's time on
   /// it); applies and reports a change of the search effort.
-  void keepRate(RateGovernor& governor, FusionPipeline& pipeline, const InputMatch& match,
-                double busy_ms);
+  void keepRate(RateGovernor& governor, FusionPipeline& pipeline, double busy_ms);
   /// LiDAR -> camera at extrinsicsStamp(), waiting up to ~tf_timeout. On a failure: counted,
   /// warned and false (the frame is skipped).
   bool lookupExtrinsics(const InputMatch& match, Eigen::Isometry3d& T_cam_lidar);

@@ -69,6 +69,8 @@ class InputGate {
   /// Incremented whenever ROS time or the stamps restart (a bag loop): a set that arrived in an
   /// earlier epoch cannot measure its latency in ROS time.
   uint32_t clockEpoch() const { return clock_epoch_; }
+  /// [s] The time between matched sets (FreshWait's median interval); 0 while not known.
+  double inputPeriod();
   /// The input topics (resolved, as subscribed), comma-separated.
   std::string inputTopics() const;
   /// How the image inputs are subscribed (~image_transport and the installed plugins).

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "lidar_stereo_fusion/core/patchmatch/params.h"
+#include "lidar_stereo_fusion/core/pipeline.h"
 
 namespace lidar_stereo_fusion {
 
@@ -33,8 +33,9 @@ struct EffortStep {
 /// The steps for `base`: its own search first (pixels without bounds searched down to the finer
 /// of unbounded_scale and search_scale), then unbounded_scale times coarse_scale up to the
 /// coarsest level (coarse_scale^coarse_levels), then one sweep at the coarsest level if `base`
-/// has more. A base without coarse levels, or already at the last step, has one step.
-std::vector<EffortStep> effortSteps(const PatchMatchParams& base);
+/// has more. A method that is not fused (no scan-line bounds to search by), a base without
+/// coarse levels, or one already at the last step, has one step.
+std::vector<EffortStep> effortSteps(const FusionParams& base);
 
 class RateGovernor {
  public:
@@ -43,41 +44,36 @@ class RateGovernor {
   static constexpr int kCalmFrames = 100;   ///< frames in a row without drops before a step up
   static constexpr double kHeadroom = 0.8;  ///< step up when predicted <= this share of a period
 
-  explicit RateGovernor(const PatchMatchParams& base) { rebase(base); }
+  explicit RateGovernor(const FusionParams& base) { rebase(base); }
 
   /// After each processed frame: `dropped` input sets dropped since the previous call (the worker
-  /// was busy when a newer one came), the frame's image `stamp` [s] and the worker's time on it
-  /// `busy_ms`. Returns true when the step changed; params() is then what the next frame uses
-  /// and reason() says why.
-  bool observe(unsigned dropped, double stamp, double busy_ms);
+  /// was busy when a newer one came), the input `period` [s] (InputGate::inputPeriod; 0 = not
+  /// known: no step up) and the worker's time on the frame `busy_ms`. Returns true when the step
+  /// changed; params() is then what the next frame uses and reason() says why.
+  bool observe(unsigned dropped, double period, double busy_ms);
 
   /// The configured parameters with the current step's search (at the first step, as configured).
-  PatchMatchParams params() const;
+  FusionParams params() const;
   /// The parameters changed (dynamic_reconfigure): the steps follow them, from the first.
-  void rebase(const PatchMatchParams& base);
+  void rebase(const FusionParams& base);
 
   int step() const { return step_; }
   int steps() const { return static_cast<int>(steps_.size()); }
   const EffortStep& current() const { return steps_[static_cast<size_t>(step_)]; }
   const std::string& reason() const { return reason_; }
-  /// The time between input sets [s] seen between two frames with no drop between them (the
-  /// median of the last kWindow such), or 0 before there is one.
-  double period() const;
 
  private:
   void changeStep(int step, const std::string& why);
   static double median(std::vector<double> v);
 
-  PatchMatchParams base_;
+  FusionParams base_;
   std::vector<EffortStep> steps_;
   int step_ = 0;
   std::deque<bool> late_;        ///< the last kWindow frames at this step: followed by drops
   std::deque<double> busy_;      ///< their busy times [ms]
-  std::deque<double> periods_;   ///< intervals [s] between frames without a drop between them
   std::vector<double> leaving_;  ///< per step: median busy time when it was left for the next
   std::vector<double> arrived_;  ///< per step: median busy time of its first window
   int calm_ = 0;                 ///< frames in a row without drops at this step
-  double last_stamp_ = -1.0;
   std::string reason_;
 };
 
