@@ -98,6 +98,7 @@ void scoreDepthCase(const DepthCase& c, const AccuracyOptions& options,
       projectCloud(c.fed, c.calib.T_cam_velo, camera, options.fused.projection, View::kLeft);
   RegionMasks masks = computeRegionMasks(fed, c.frame.left);
   masks.setDepthBands(c.reference);
+  masks.setInBothViews(depthToDisparity(c.reference, camera));
   const auto add = [&](const std::string& name, const cv::Mat1f& depth, double seconds) {
     acc.add(name, scoreRegions(depth, c.reference, masks, camera), rawCoverage(depth, c.reference),
             seconds);

@@ -73,7 +73,8 @@ void scoreMiddleburyLayout(const MiddleburyScene& scene, const std::string& scen
   const StereoCamera camera = dummyCamera(scene.left.size());
   const SparseDisparity left_sparse = middleburyLayout(scene.disparity, layout.name);
   const SparseDisparity right_sparse = shiftToRightView(left_sparse);
-  const RegionMasks masks = computeRegionMasks(left_sparse, scene.left);
+  RegionMasks masks = computeRegionMasks(left_sparse, scene.left);
+  masks.setInBothViews(scene.disparity);
   layout.items.push_back(scene_name);
   layout.fed_rings.push_back(countRings(left_sparse.ring));
   if (layout.fed_rows.empty()) {

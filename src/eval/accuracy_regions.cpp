@@ -67,6 +67,8 @@ std::string regionName(Region region) {
       return "10-30 m";
     case Region::kFar:
       return ">= 30 m";
+    case Region::kAboveBothViews:
+      return "above, both views";
   }
   return "unknown";
 }
@@ -88,6 +90,8 @@ const cv::Mat1b& RegionMasks::mask(Region region) const {
       return mid;
     case Region::kFar:
       return far;
+    case Region::kAboveBothViews:
+      return above_both_views;
     case Region::kAll:
       break;
   }
@@ -146,6 +150,7 @@ RegionMasks computeRegionMasks(const SparseDisparity& fed, const cv::Mat& image,
   masks.near = cv::Mat1b(rows, cols, uchar(0));
   masks.mid = masks.near.clone();
   masks.far = masks.near.clone();
+  masks.above_both_views = masks.near.clone();
   return masks;
 }
 
@@ -194,6 +199,21 @@ cv::Mat1f combineMaps(const cv::Mat1f& primary, const cv::Mat1f& fallback) {
     }
   }
   return out;
+}
+
+void RegionMasks::setInBothViews(const cv::Mat1f& reference_disparity) {
+  if (reference_disparity.size() != above.size()) {
+    throw std::invalid_argument("RegionMasks::setInBothViews: the reference differs in size");
+  }
+  above_both_views = cv::Mat1b(above.size(), uchar(0));
+  for (int y = 0; y < above.rows; ++y) {
+    for (int x = 0; x < above.cols; ++x) {
+      const float d = reference_disparity(y, x);
+      if (above(y, x) && hasValue(d) && static_cast<float>(x) - d >= 0.f) {
+        above_both_views(y, x) = 255;
+      }
+    }
+  }
 }
 
 }  // namespace lidar_stereo_fusion

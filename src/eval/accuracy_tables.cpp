@@ -14,8 +14,8 @@ using table::format;
 using table::row;
 using table::separator;
 
-const std::vector<Region> kSplitRegions = {Region::kAbove, Region::kInside, Region::kEdge,
-                                           Region::kElsewhere};
+const std::vector<Region> kSplitRegions = {Region::kAbove, Region::kAboveBothViews, Region::kInside,
+                                           Region::kEdge, Region::kElsewhere};
 const std::vector<Region> kBands = {Region::kAll, Region::kNear, Region::kMid, Region::kFar};
 
 /// Adds "raw coverage %" and "ms / <item>" (the method's wall time per scene / frame) columns to a

@@ -26,9 +26,12 @@ const Metrics& region(const MethodScores<Metrics>& m, Region r) {
   return m.mean[static_cast<int>(r)];
 }
 
-/// above + inside and edge + elsewhere partition the scored pixels.
+/// above + inside and edge + elsewhere partition the scored pixels; "above, both views" is part
+/// of "above".
 template <typename Metrics>
 void expectRegionsPartition(const MethodScores<Metrics>& m, const std::string& layout) {
+  EXPECT_LE(region(m, Region::kAboveBothViews).count, region(m, Region::kAbove).count)
+      << layout << " " << m.name;
   EXPECT_EQ(region(m, Region::kAbove).count + region(m, Region::kInside).count,
             region(m, Region::kAll).count)
       << layout << " " << m.name;
@@ -57,8 +60,13 @@ TEST(AccuracyProtocols, MiddleburyLayoutsFullCoverageAfterTheFillAndAccurateLida
   // Nearest needs no fill: it covers every pixel itself.
   EXPECT_EQ(layouts[0].find("nearest")->raw_coverage, 1.0);
   // Sparser layouts leave more pixels above the LiDAR.
-  EXPECT_LT(region(*mb64, Region::kAbove).count,
-            region(*layouts[2].find("lidar_bi"), Region::kAbove).count);
+  const auto* low = layouts[2].find("lidar_bi");
+  EXPECT_LT(region(*mb64, Region::kAbove).count, region(*low, Region::kAbove).count);
+  // Above the lower 2/3, the left border band the right image does not see (x < d: up to 64
+  // columns of 450) is left out of "above, both views", and the rest is kept.
+  EXPECT_LT(region(*low, Region::kAboveBothViews).count, region(*low, Region::kAbove).count);
+  EXPECT_GT(region(*low, Region::kAboveBothViews).count,
+            region(*low, Region::kAbove).count * 8 / 10);
 }
 
 TEST(AccuracyProtocols, MiddleburyLowerTwoThirdsLayoutFeedsExactlyTheStatedRows) {

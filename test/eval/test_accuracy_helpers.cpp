@@ -125,6 +125,24 @@ TEST(RegionMasks, DepthBandsSplitTheReferenceAtTenAndThirtyMetres) {
   EXPECT_THROW(m.setDepthBands(cv::Mat1f(8, 4, 0.f)), std::invalid_argument);
 }
 
+TEST(RegionMasks, AboveInBothViewsIsWhereTheMatchLiesInsideTheRightImage) {
+  RegionMasks m = computeRegionMasks(twoLines(10.f, 13.f), cv::Mat(9, 4, CV_8UC1, 0.0));
+  EXPECT_EQ(cv::countNonZero(m.above_both_views), 0);         // empty until the reference is known
+  cv::Mat1f reference(9, 4, 2.f);                             // x - 2 >= 0 from column 2 on
+  reference(0, 3) = 3.f;                                      // x - d = 0: the match is column 0
+  reference(1, 3) = 3.5f;                                     // x - d < 0: outside the right image
+  reference(1, 2) = std::numeric_limits<float>::quiet_NaN();  // no reference
+  reference(4, 3) = 1.f;                                      // below the top line: not "above"
+  m.setInBothViews(reference);
+  // "above" is rows 0-1; of those, columns 2-3 except (1, 2) and (1, 3).
+  EXPECT_EQ(cv::countNonZero(m.above_both_views), 2);
+  EXPECT_EQ(m.above_both_views(0, 2), 255);
+  EXPECT_EQ(m.above_both_views(0, 3), 255);
+  EXPECT_EQ(&m.mask(Region::kAboveBothViews), &m.above_both_views);
+  EXPECT_EQ(regionName(Region::kAboveBothViews), "above, both views");
+  EXPECT_THROW(m.setInBothViews(cv::Mat1f(8, 4, 0.f)), std::invalid_argument);
+}
+
 TEST(AccuracyLayouts, MiddleburyRowsAndKittiKeepEvery) {
   const cv::Mat1f gt(90, 5, 4.f);
   EXPECT_EQ(cv::countNonZero(middleburyLayout(gt, "mb64").disparity), 64 * 5);

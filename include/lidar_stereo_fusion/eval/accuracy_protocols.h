@@ -26,6 +26,11 @@
 // disparity of the left view:
 //  * "above"  : pixels above the topmost fed pixel of their column (a column without any fed
 //               pixel is entirely "above": no LiDAR looks at it);
+//  * "above, both views": "above" pixels whose reference match x - d lies inside the right image
+//               (set by RegionMasks::setInBothViews from the reference disparity): only the
+//               images decide there, and both show the pixel. The rest of "above" is the band at
+//               the left border that the right image does not see, where a method can only
+//               guess (hole filling), and which weighs differently from scene to scene;
 //  * "inside" : every other pixel (on or below the topmost fed pixel of the column);
 //  * "edge"   : inside pixels strictly between two scan lines of their column (not on a line)
 //               whose lines differ by more than 3 px: the scan lines are those of BI* after
@@ -53,22 +58,28 @@
 
 namespace lidar_stereo_fusion {
 
-enum class Region { kAll, kAbove, kInside, kEdge, kElsewhere, kNear, kMid, kFar };
-constexpr int kRegionCount = 8;
+enum class Region { kAll, kAbove, kInside, kEdge, kElsewhere, kNear, kMid, kFar, kAboveBothViews };
+constexpr int kRegionCount = 9;
 /// The depth bands' limits [m] (kNear: z < kNearBandMax, kFar: z >= kFarBandMin).
 constexpr double kNearBandMax = 10.0;
 constexpr double kFarBandMin = 30.0;
-/// "all", "above", "inside", "edge", "elsewhere", "< 10 m", "10-30 m", ">= 30 m".
+/// "all", "above", "inside", "edge", "elsewhere", "< 10 m", "10-30 m", ">= 30 m", "above, both
+/// views".
 std::string regionName(Region region);
 
 /// Region masks of one image (CV_8U, 255 inside the region); see the file comment.
 struct RegionMasks {
   cv::Mat1b above, inside, edge, elsewhere;
   cv::Mat1b near, mid, far;                    ///< depth bands; all 0 until setDepthBands
+  cv::Mat1b above_both_views;                  ///< all 0 until setInBothViews
   const cv::Mat1b& mask(Region region) const;  ///< empty Mat for kAll
   /// Sets the depth bands from a reference depth map [m] (0 / NaN = no reference) of the masks'
   /// size. Throws std::invalid_argument on a size mismatch.
   void setDepthBands(const cv::Mat1f& reference_depth);
+  /// Sets above_both_views from the left view's reference disparity [px] (0 / NaN = none) of the
+  /// masks' size: the "above" pixels (x, y) with x - d >= 0. Throws std::invalid_argument on a
+  /// size mismatch.
+  void setInBothViews(const cv::Mat1f& reference_disparity);
 };
 
 /// Masks from the fed left-view sparse disparity and the left image (BGR or grey, same size); the
