@@ -70,15 +70,24 @@ ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
                        const FusionParams& params) {
   ViewPrior v;
   std::vector<cv::Point> removed;
-  // upsampleBI's steps, with one column index for Eq. 3, the bounds and the confidence.
+  // upsampleBI's steps, with one column index for Algorithm 1, Eq. 3, the bounds and the
+  // confidence, and BI*'s three maps in one pass.
   v.lines = completeScanLines(sparse, params.bi);
-  v.removed = removeOccludedPoints(v.lines, image, params.bi, &removed);
-  const ColumnIndex index(v.lines.disparity);
-  v.prior = usesBF(params.method)
-                ? upsampleBF(sparse, params.bf)
-                : interpolateBetweenScanLines(index, v.lines.disparity, params.bi);
-  v.bounds = computeScanLineBounds(index, v.lines.disparity, params.patchmatch.bound_margin);
-  v.confidence = priorConfidence(index, v.lines.disparity, v.prior, removed, params.confidence);
+  const ColumnIndex index = removeOccludedPointsIndexed(v.lines, image, params.bi, removed);
+  v.removed = static_cast<int>(removed.size());
+  const double margin = params.patchmatch.bound_margin;
+  if (usesBF(params.method)) {
+    v.prior = upsampleBF(sparse, params.bf);
+    v.bounds = computeScanLineBounds(index, v.lines.disparity, margin);
+    v.confidence = priorConfidence(index, v.lines.disparity, v.prior, removed, params.confidence);
+  } else {
+    const IntervalConfidence model(params.confidence, v.lines.disparity.size(), removed);
+    IntervalMaps maps;
+    maps.prior = &v.prior;
+    maps.bounds = &v.bounds;
+    maps.confidence = &v.confidence;
+    scanLineIntervals(index, v.lines.disparity, params.bi.max_interp_rows, margin, &model, maps);
+  }
   if (isFused(params.method) && params.patchmatch.confidence_weighting) {
     fillPriorHoles(v.prior, v.confidence, params.confidence);
   }

@@ -50,6 +50,37 @@ cv::Mat1f priorConfidence(const ScanLines& lines, const cv::Mat1f& prior,
   return priorConfidence(ColumnIndex(lines.disparity), lines.disparity, prior, removed, params);
 }
 
+IntervalConfidence::IntervalConfidence(const PriorConfidenceParams& params, const cv::Size& size,
+                                       const std::vector<cv::Point>& removed)
+    : tolerance_(static_cast<float>(params.edge_tolerance)),
+      inv_sigma_(static_cast<float>(1.0 / params.edge_sigma)),
+      max_slope_(static_cast<float>(params.max_surface_slope)),
+      removed_factor_(static_cast<float>(params.removed_factor)),
+      near_(static_cast<size_t>(size.height / 2 + 1)),
+      removed_rows_(static_cast<size_t>(size.width)) {
+  // The distance factor by row distance to the nearer line, tabulated (the same float expression).
+  const float near_rows = static_cast<float>(params.near_rows);
+  const float inv_decay = params.decay_rows > 0 ? static_cast<float>(1.0 / params.decay_rows) : 0.f;
+  for (size_t dist = 0; dist < near_.size(); ++dist) {
+    near_[dist] = std::exp(-std::max(0.f, static_cast<float>(dist) - near_rows) * inv_decay);
+  }
+  for (const cv::Point& p : removed) {
+    if (p.x >= 0 && p.x < size.width && p.y >= 0 && p.y < size.height) {
+      removed_rows_[static_cast<size_t>(p.x)].push_back(p.y);
+    }
+  }
+  for (auto& r : removed_rows_) std::sort(r.begin(), r.end());
+}
+
+float IntervalConfidence::agreement(const ColumnEntry* e, int n, int k, int x) const {
+  float a =
+      std::exp(-std::max(0.f, intervalResidual(e, n, k, max_slope_) - tolerance_) * inv_sigma_);
+  const std::vector<int>& gone = removed_rows_[static_cast<size_t>(x)];
+  const auto it = std::upper_bound(gone.begin(), gone.end(), e[k].y);
+  if (it != gone.end() && *it < e[k + 1].y) a *= removed_factor_;
+  return a;
+}
+
 cv::Mat1f priorConfidence(const ColumnIndex& index, const cv::Mat1f& lines, const cv::Mat1f& prior,
                           const std::vector<cv::Point>& removed,
                           const PriorConfidenceParams& params) {
@@ -61,27 +92,11 @@ cv::Mat1f priorConfidence(const ColumnIndex& index, const cv::Mat1f& lines, cons
     throw std::invalid_argument("priorConfidence: scan lines and prior differ in size");
   }
   const int rows = prior.rows, cols = prior.cols;
-  // Removed pixels by column, each column sorted by row.
-  std::vector<std::vector<int>> removed_rows(cols);
-  for (const cv::Point& p : removed) {
-    if (p.x >= 0 && p.x < cols && p.y >= 0 && p.y < rows) removed_rows[p.x].push_back(p.y);
-  }
-  for (auto& r : removed_rows) std::sort(r.begin(), r.end());
-
-  const float tolerance = static_cast<float>(params.edge_tolerance);
-  const float inv_sigma = static_cast<float>(1.0 / params.edge_sigma);
-  const float max_slope = static_cast<float>(params.max_surface_slope);
-  const float near_rows = static_cast<float>(params.near_rows);
-  const float inv_decay = params.decay_rows > 0 ? static_cast<float>(1.0 / params.decay_rows) : 0.f;
-  const float removed_factor = static_cast<float>(params.removed_factor);
-
-  // The distance factor by row distance to the nearer line, tabulated (the same float expression).
-  std::vector<float> near(static_cast<size_t>(rows / 2 + 1));
-  for (size_t dist = 0; dist < near.size(); ++dist) {
-    near[dist] = std::exp(-std::max(0.f, static_cast<float>(dist) - near_rows) * inv_decay);
-  }
+  const IntervalConfidence model(params, prior.size(), removed);
   // Row by row (a column walk writes a cache line per pixel): each column keeps the interval it is
-  // in (rows, agreement; y_down -1 where it is not bridged), set when the row passes a line.
+  // in (rows, agreement; y_down -1 where it is not bridged), set when the row passes a line. Any
+  // prior (BI*'s, BF*'s): where it bridges a pair of lines is read from it. (BI*'s own prior and
+  // confidence come in one pass: scanLineIntervals.)
   cv::Mat1f confidence(prior.size());
   std::vector<int> line_index(static_cast<size_t>(cols), 0), y_up(line_index),
       y_down(static_cast<size_t>(cols), -1);
@@ -92,7 +107,7 @@ cv::Mat1f priorConfidence(const ColumnIndex& index, const cv::Mat1f& lines, cons
     for (int x = 0; x < cols; ++x) {
       const int up = y_up[static_cast<size_t>(x)], down = y_down[static_cast<size_t>(x)];
       c[x] = y < down && p[x] > 0.f
-                 ? agree[static_cast<size_t>(x)] * near[std::min(y - up, down - y)]
+                 ? agree[static_cast<size_t>(x)] * model.nearness(std::min(y - up, down - y))
                  : 0.f;
     }
     const float* on_line = lines[y];
@@ -107,14 +122,9 @@ cv::Mat1f priorConfidence(const ColumnIndex& index, const cv::Mat1f& lines, cons
       if (k + 1 == n) continue;
       const int y_next = e[k + 1].y;
       if (y_next - y < 2 || !(prior(y + 1, x) > 0.f)) continue;  // adjacent, or not bridged
-      float a =
-          std::exp(-std::max(0.f, intervalResidual(e, n, k, max_slope) - tolerance) * inv_sigma);
-      const std::vector<int>& gone = removed_rows[xs];
-      const auto it = std::upper_bound(gone.begin(), gone.end(), y);
-      if (it != gone.end() && *it < y_next) a *= removed_factor;
       y_up[xs] = y;
       y_down[xs] = y_next;
-      agree[xs] = a;
+      agree[xs] = model.agreement(e, n, k, x);
     }
   }
   return confidence;

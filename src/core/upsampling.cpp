@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -124,6 +125,13 @@ ScanLines completeScanLines(const SparseDisparity& sparse, const BIParams& param
   lines.ring.create(disparity.size());
   lines.ring.setTo(-1);
 
+  // Every value finite and >= 0: OpenCV's vectorised range check (NaN fails it too), then the
+  // points alone are visited.
+  cv::Point bad;
+  if (!cv::checkRange(disparity, true, &bad, 0.0, std::numeric_limits<float>::infinity())) {
+    throw std::invalid_argument("completeScanLines: disparity at (" + std::to_string(bad.x) + ", " +
+                                std::to_string(bad.y) + ") is not finite and >= 0");
+  }
   // Group the projected points by ring; ring-less points are written as single pixels.
   std::vector<std::vector<RingPoint>> rings;
   for (int y = 0; y < disparity.rows; ++y) {
@@ -131,10 +139,6 @@ ScanLines completeScanLines(const SparseDisparity& sparse, const BIParams& param
     const short* r_row = has_ring_map ? sparse.ring[y] : nullptr;
     for (int x = 0; x < disparity.cols; ++x) {
       const float d = d_row[x];
-      if (!(d >= 0.f) || !std::isfinite(d)) {
-        throw std::invalid_argument("completeScanLines: disparity at (" + std::to_string(x) + ", " +
-                                    std::to_string(y) + ") is not finite and >= 0");
-      }
       if (d == 0.f) continue;
       const int ring = r_row ? r_row[x] : -1;
       if (ring < 0) {
@@ -155,8 +159,14 @@ ScanLines completeScanLines(const SparseDisparity& sparse, const BIParams& param
   return lines;
 }
 
-int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams& params,
-                         std::vector<cv::Point>* removed_pixels) {
+namespace {
+
+/// Algorithm 1's decisions on the lines' state, by column (the pixels to clear, ordered by column,
+/// then row). Every decision is taken on the input state: the pixels are cleared afterwards, so
+/// the result does not depend on the scan order and a removed background pixel never changes the
+/// verdict on another one in the same pass.
+std::vector<cv::Point> occludedPoints(const ColumnIndex& index, const ScanLines& lines,
+                                      const cv::Mat& image, const BIParams& params) {
   params.validate();
   requireDisparityMap(lines.disparity, "removeOccludedPoints");
   if (image.size() != lines.disparity.size()) {
@@ -165,15 +175,9 @@ int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams&
   if (image.type() != CV_8UC3 && image.type() != CV_8UC1) {
     throw std::invalid_argument("removeOccludedPoints: image must be CV_8UC3 (BGR) or CV_8UC1");
   }
-  const bool has_ring_map = !lines.ring.empty();
-  if (has_ring_map && lines.ring.size() != lines.disparity.size()) {
+  if (!lines.ring.empty() && lines.ring.size() != lines.disparity.size()) {
     throw std::invalid_argument("removeOccludedPoints: ring map size differs from disparity size");
   }
-
-  // Every decision is taken on the input state: the pixels to clear are collected first and
-  // cleared afterwards, so the result does not depend on the scan order and a removed background
-  // pixel never changes the verdict on another one in the same pass.
-  const ColumnIndex index(lines.disparity);
   std::vector<cv::Point> removed;
   for (int x = 0; x < index.cols(); ++x) {
     const ColumnEntry* entries = index.column(x);
@@ -185,13 +189,39 @@ int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams&
       }
     }
   }
-  for (const cv::Point& p : removed) {
+  return removed;
+}
+
+void clearPixels(ScanLines& lines, const std::vector<cv::Point>& pixels) {
+  const bool has_ring_map = !lines.ring.empty();
+  for (const cv::Point& p : pixels) {
     lines.disparity(p) = 0.f;
     if (has_ring_map) lines.ring(p) = -1;
   }
+}
+
+}  // namespace
+
+int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams& params,
+                         std::vector<cv::Point>* removed_pixels) {
+  // (lines.disparity is checked before the index is built on it.)
+  requireDisparityMap(lines.disparity, "removeOccludedPoints");
+  std::vector<cv::Point> removed =
+      occludedPoints(ColumnIndex(lines.disparity), lines, image, params);
+  clearPixels(lines, removed);
   const int count = static_cast<int>(removed.size());
   if (removed_pixels) *removed_pixels = std::move(removed);
   return count;
+}
+
+ColumnIndex removeOccludedPointsIndexed(ScanLines& lines, const cv::Mat& image,
+                                        const BIParams& params, std::vector<cv::Point>& removed) {
+  requireDisparityMap(lines.disparity, "removeOccludedPoints");
+  ColumnIndex index(lines.disparity);
+  removed = occludedPoints(index, lines, image, params);
+  clearPixels(lines, removed);
+  index.erase(removed);
+  return index;
 }
 
 cv::Mat1f interpolateBetweenScanLines(const ScanLines& lines, const BIParams& params) {
@@ -202,33 +232,21 @@ cv::Mat1f interpolateBetweenScanLines(const ColumnIndex& index, const cv::Mat1f&
                                       const BIParams& params) {
   params.validate();
   requireDisparityMap(lines, "interpolateBetweenScanLines");
-  cv::Mat1f out = cv::Mat1f::zeros(lines.size());
-  for (int x = 0; x < index.cols(); ++x) {
-    const ColumnEntry* entries = index.column(x);
-    const int n = index.size(x);
-    for (int k = 0; k < n; ++k) {
-      out(entries[k].y, x) = entries[k].d;
-      if (k + 1 == n) break;
-      const ColumnEntry& up = entries[k];
-      const ColumnEntry& down = entries[k + 1];
-      const int gap = down.y - up.y;
-      if (gap > params.max_interp_rows) continue;
-      for (int y = up.y + 1; y < down.y; ++y) {  // Eq. 3
-        out(y, x) = static_cast<float>(
-            (static_cast<double>(y - up.y) * down.d + static_cast<double>(down.y - y) * up.d) /
-            gap);
-      }
-    }
-  }
+  cv::Mat1f out;
+  IntervalMaps maps;
+  maps.prior = &out;
+  scanLineIntervals(index, lines, params.max_interp_rows, 0.0, nullptr, maps);  // Eq. 3
   return out;
 }
 
 cv::Mat1f upsampleBI(const SparseDisparity& sparse, const cv::Mat& image, const BIParams& params,
                      int* removed, ScanLines* lines_out, std::vector<cv::Point>* removed_pixels) {
   ScanLines lines = completeScanLines(sparse, params);
-  const int count = removeOccludedPoints(lines, image, params, removed_pixels);
-  if (removed) *removed = count;
-  cv::Mat1f dense = interpolateBetweenScanLines(lines, params);
+  std::vector<cv::Point> cleared;
+  const ColumnIndex index = removeOccludedPointsIndexed(lines, image, params, cleared);
+  if (removed) *removed = static_cast<int>(cleared.size());
+  if (removed_pixels) *removed_pixels = std::move(cleared);
+  cv::Mat1f dense = interpolateBetweenScanLines(index, lines.disparity, params);
   if (lines_out) *lines_out = std::move(lines);
   return dense;
 }
@@ -244,39 +262,10 @@ ScanLineBounds computeScanLineBounds(const ColumnIndex& index, const cv::Mat1f& 
     throw std::invalid_argument("computeScanLineBounds: margin_px must be finite and >= 0, got " +
                                 std::to_string(margin_px));
   }
-  // Row by row (a column walk writes a cache line per pixel): each column keeps the bounds of the
-  // interval it is in, set when the row passes a line; a pixel on a line takes the lines around it.
-  const int rows = lines.rows, cols = lines.cols;
   ScanLineBounds bounds;
-  bounds.lo.create(lines.size());
-  bounds.hi.create(lines.size());
-  bounds.range.create(lines.size());
-  cv::Mat1f interval = cv::Mat1f::zeros(3, cols);  // lo, hi, range of each column's interval
-  std::vector<int> line_index(static_cast<size_t>(cols), 0);  // the column's next line
-  const auto set = [margin_px](float d_up, float d_down, float& lo, float& hi, float& range) {
-    lo = static_cast<float>(std::min(d_up, d_down) - margin_px);
-    hi = static_cast<float>(std::max(d_up, d_down) + margin_px);
-    range = std::abs(d_up - d_down);
-  };
-  for (int y = 0; y < rows; ++y) {
-    float* lo = bounds.lo[y];
-    float* hi = bounds.hi[y];
-    float* range = bounds.range[y];
-    std::copy(interval[0], interval[0] + cols, lo);
-    std::copy(interval[1], interval[1] + cols, hi);
-    std::copy(interval[2], interval[2] + cols, range);
-    const float* on_line = lines[y];
-    for (int x = 0; x < cols; ++x) {
-      if (!(on_line[x] > 0.f)) continue;
-      const ColumnEntry* e = index.column(x);
-      const int k = line_index[static_cast<size_t>(x)]++;  // e[k] is this pixel
-      const bool below = k + 1 < index.size(x);
-      lo[x] = hi[x] = range[x] = 0.f;
-      if (k >= 1 && below) set(e[k - 1].d, e[k + 1].d, lo[x], hi[x], range[x]);
-      interval(0, x) = interval(1, x) = interval(2, x) = 0.f;
-      if (below) set(e[k].d, e[k + 1].d, interval(0, x), interval(1, x), interval(2, x));
-    }
-  }
+  IntervalMaps maps;
+  maps.bounds = &bounds;
+  scanLineIntervals(index, lines, 0, margin_px, nullptr, maps);
   return bounds;
 }
 
