@@ -4,7 +4,8 @@
 //
 // Column-wise steps (Algorithm 1, Eq. 3, bounds) first index the scan-line pixels by column in one
 // row-major pass, then write their results straight into the output; no full-size temporaries
-// (fresh full-size buffers cost page faults every frame).
+// (fresh full-size buffers cost page faults every frame). Eq. 3 and the bounds are one row pass
+// over that index, shared with the prior's confidence: scan_line_intervals.cpp.
 #include "lidar_stereo_fusion/core/upsampling.h"
 
 #include "lidar_stereo_fusion/core/param_table.h"
