@@ -158,11 +158,15 @@ void fillRows(HoleFill& f, float tolerance) {
   std::vector<int> top(static_cast<size_t>(prior.cols), prior.rows);
   std::vector<float> top_value(static_cast<size_t>(prior.cols),
                                std::numeric_limits<float>::infinity());
-  for (int y = prior.rows - 1; y >= 0; --y) {
+  // Each column's first value from the top; the rows below the last column's top are not read.
+  int remaining = prior.cols;
+  for (int y = 0; y < prior.rows && remaining > 0; ++y) {
+    const float* row = prior[y];
     for (int x = 0; x < prior.cols; ++x) {
-      if (prior(y, x) > 0.f) {
+      if (top[x] == prior.rows && row[x] > 0.f) {
         top[x] = y;
-        top_value[x] = prior(y, x);
+        top_value[x] = row[x];
+        --remaining;
       }
     }
   }
