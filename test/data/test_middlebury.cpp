@@ -4,7 +4,8 @@
 // the default fused method, and the live preset (config/live.yaml), must each have a lower MAE and
 // a lower bad-2 rate than each of LiDAR-only BI*, plain PMS, "LiDAR-only else PMS" and the
 // nearest-point fill, by a margin; and the paper preset must reproduce the fused_bi numbers of the
-// package before confidence weighting.
+// package before confidence weighting. Above the LiDAR where both views see the pixel, both presets
+// stay near plain PMS.
 #include <iostream>
 
 #include <gtest/gtest.h>
@@ -96,6 +97,39 @@ TEST(Middlebury, FusedBeatsEveryBaselineWithRowsInTheLowerTwoThirdsOnly) {
   LSF_REQUIRE_DATA("middlebury/cones");
   LSF_REQUIRE_DATA("middlebury/teddy");
   expectFusedBeatsEveryBaseline("mb42low");
+}
+
+// Above the LiDAR (the lower 2/3's top third), where both images see the pixel (region "above,
+// both views": the left border band the right image does not see is left out), only stereo
+// decides. There the default, which searches it at full size, must stay within 15 % of plain PMS
+// (0.348 against 0.330 px at seed 42); `live`, which searches it at 1/4 and 1/2 size only, within
+// 50 % (0.457 px). A guard for the speed work, not the goal: issue 32 wants `live` ahead there, and
+// only a full-size search has closed the gap so far (doc/accuracy.md).
+TEST(Middlebury, AboveTheLidarWhereBothViewsSeeThePixelStereoStaysNearPlainPms) {
+  LSF_REQUIRE_DATA("middlebury/cones");
+  LSF_REQUIRE_DATA("middlebury/teddy");
+  const auto region = [](const LayoutScores<DisparityMetrics>& layout, const std::string& m) {
+    const MethodScores<DisparityMetrics>* scores = layout.find(m);
+    if (!scores) throw std::runtime_error("method " + m + " did not run on " + layout.name);
+    return scores->mean[static_cast<int>(Region::kAboveBothViews)];
+  };
+  for (const auto& layout : results()) {
+    if (layout.name != "mb42low") continue;
+    const DisparityMetrics pms = region(layout, "pms");
+    const DisparityMetrics fused = region(layout, "fused");
+    ASSERT_GT(pms.count, 0);
+    EXPECT_LT(fused.mae_px, 1.15 * pms.mae_px);
+    for (const auto& live_layout : liveResults()) {
+      if (live_layout.name != "mb42low") continue;
+      const DisparityMetrics live = region(live_layout, "fused");
+      EXPECT_EQ(live.count, pms.count);
+      EXPECT_LT(live.mae_px, 1.5 * pms.mae_px);
+      std::cout << "above, both views: fused " << fused.mae_px << " px, live " << live.mae_px
+                << " px, pms " << pms.mae_px << " px\n";
+      return;
+    }
+  }
+  FAIL() << "mb42low did not run";
 }
 
 // The fused_bi numbers of the package before confidence weighting (same protocol, devkit fill),
