@@ -91,42 +91,11 @@ cv::Mat1f priorConfidence(const ColumnIndex& index, const cv::Mat1f& lines, cons
   if (lines.size() != prior.size()) {
     throw std::invalid_argument("priorConfidence: scan lines and prior differ in size");
   }
-  const int rows = prior.rows, cols = prior.cols;
   const IntervalConfidence model(params, prior.size(), removed);
-  // Row by row (a column walk writes a cache line per pixel): each column keeps the interval it is
-  // in (rows, agreement; y_down -1 where it is not bridged), set when the row passes a line. Any
-  // prior (BI*'s, BF*'s): where it bridges a pair of lines is read from it. (BI*'s own prior and
-  // confidence come in one pass: scanLineIntervals.)
-  cv::Mat1f confidence(prior.size());
-  std::vector<int> line_index(static_cast<size_t>(cols), 0), y_up(line_index),
-      y_down(static_cast<size_t>(cols), -1);
-  std::vector<float> agree(static_cast<size_t>(cols), 0.f);
-  for (int y = 0; y < rows; ++y) {
-    const float* p = prior[y];
-    float* c = confidence[y];
-    for (int x = 0; x < cols; ++x) {
-      const int up = y_up[static_cast<size_t>(x)], down = y_down[static_cast<size_t>(x)];
-      c[x] = y < down && p[x] > 0.f
-                 ? agree[static_cast<size_t>(x)] * model.nearness(std::min(y - up, down - y))
-                 : 0.f;
-    }
-    const float* on_line = lines[y];
-    for (int x = 0; x < cols; ++x) {
-      if (!(on_line[x] > 0.f)) continue;
-      const size_t xs = static_cast<size_t>(x);
-      const ColumnEntry* e = index.column(x);
-      const int n = index.size(x);
-      const int k = line_index[xs]++;  // e[k] is this pixel
-      c[x] = p[x] > 0.f ? 1.f : 0.f;
-      y_down[xs] = -1;
-      if (k + 1 == n) continue;
-      const int y_next = e[k + 1].y;
-      if (y_next - y < 2 || !(prior(y + 1, x) > 0.f)) continue;  // adjacent, or not bridged
-      y_up[xs] = y;
-      y_down[xs] = y_next;
-      agree[xs] = model.agreement(e, n, k, x);
-    }
-  }
+  cv::Mat1f confidence;
+  IntervalMaps maps;
+  maps.confidence = &confidence;
+  scanLineIntervals(index, lines, 0, 0.0, &model, maps, &prior);
   return confidence;
 }
 

@@ -55,17 +55,19 @@ class IntervalConfidence {
 struct IntervalMaps {
   cv::Mat1f* prior = nullptr;        ///< Eq. 3: interpolateBetweenScanLines
   ScanLineBounds* bounds = nullptr;  ///< computeScanLineBounds(margin_px)
-  /// priorConfidence of that very prior (BI*'s Eq. 3, bridged up to max_interp_rows); needs a model
+  /// the prior's confidence (prior_confidence.h); needs a model
   cv::Mat1f* confidence = nullptr;
 };
 
 /// Stage 2's maps that follow each column's intervals between scan lines, in one row-major pass
 /// (a column walk writes a cache line per pixel, and each map walked the lines on its own): every
-/// output pixel is written, bit for bit what interpolateBetweenScanLines, computeScanLineBounds
-/// and priorConfidence give (rig 1280x720, 128 rings: 3.4 ms a view for the three, against 6.1).
-/// Checks nothing: the callers have.
+/// output pixel is written (rig 1280x720, 128 rings: 3.4 ms a view for the three, against 6.1).
+/// interpolateBetweenScanLines, computeScanLineBounds and priorConfidence are this pass. The
+/// confidence is of BI*'s own Eq. 3 unless `prior_of_confidence` gives another prior (BF*'s):
+/// then where it has a value and which intervals it bridges are read from it, and out.prior is
+/// not written. Checks nothing: the callers have.
 void scanLineIntervals(const ColumnIndex& index, const cv::Mat1f& lines, int max_interp_rows,
                        double margin_px, const IntervalConfidence* confidence_model,
-                       const IntervalMaps& out);
+                       const IntervalMaps& out, const cv::Mat1f* prior_of_confidence = nullptr);
 
 }  // namespace lidar_stereo_fusion

@@ -33,9 +33,12 @@ void setBounds(float d_up, float d_down, double margin_px, float& lo, float& hi,
 
 void scanLineIntervals(const ColumnIndex& index, const cv::Mat1f& lines, int max_interp_rows,
                        double margin_px, const IntervalConfidence* confidence_model,
-                       const IntervalMaps& out) {
+                       const IntervalMaps& out, const cv::Mat1f* prior_of_confidence) {
   const int rows = lines.rows, cols = lines.cols;
-  cv::Mat1f* const prior = out.prior;
+  // The prior the confidence reads (where it has a value, which intervals it bridges): BI*'s own
+  // Eq. 3 unless another is given (then Eq. 3 is not written).
+  const cv::Mat1f* const other = prior_of_confidence;
+  cv::Mat1f* const prior = other ? nullptr : out.prior;
   ScanLineBounds* const bounds = out.bounds;
   cv::Mat1f* const confidence = confidence_model ? out.confidence : nullptr;
   if (prior) prior->create(lines.size());
@@ -62,7 +65,7 @@ void scanLineIntervals(const ColumnIndex& index, const cv::Mat1f& lines, int max
         const int k = s.line++;  // e[k] is this pixel
         const bool below = k + 1 < n;
         if (p) p[x] = e[k].d;
-        if (c) c[x] = 1.f;
+        if (c) c[x] = !other || (*other)(y, x) > 0.f ? 1.f : 0.f;
         if (bounds) {
           lo[x] = hi[x] = range[x] = 0.f;
           if (k >= 1 && below) setBounds(e[k - 1].d, e[k + 1].d, margin_px, lo[x], hi[x], range[x]);
@@ -71,7 +74,10 @@ void scanLineIntervals(const ColumnIndex& index, const cv::Mat1f& lines, int max
         s.down = -1;
         if (!below) continue;
         setBounds(e[k].d, e[k + 1].d, margin_px, s.lo, s.hi, s.range);
-        if (e[k + 1].y - y > max_interp_rows) continue;  // Eq. 3 does not bridge it
+        // Eq. 3 bridges lines up to max_interp_rows apart; another prior, where it has a value
+        // just below the line (adjacent lines have nothing between them).
+        const int gap = e[k + 1].y - y;
+        if (other ? gap < 2 || !((*other)(y + 1, x) > 0.f) : gap > max_interp_rows) continue;
         s.up = y;
         s.down = e[k + 1].y;
         s.d_up = e[k].d;
@@ -90,9 +96,10 @@ void scanLineIntervals(const ColumnIndex& index, const cv::Mat1f& lines, int max
         continue;
       }
       const int gap = s.down - s.up;
-      const float d = static_cast<float>(
-          (static_cast<double>(y - s.up) * s.d_down + static_cast<double>(s.down - y) * s.d_up) /
-          gap);  // Eq. 3
+      const float d = other ? (*other)(y, x)
+                            : static_cast<float>((static_cast<double>(y - s.up) * s.d_down +
+                                                  static_cast<double>(s.down - y) * s.d_up) /
+                                                 gap);  // Eq. 3
       if (p) p[x] = d;
       if (c)
         c[x] = d > 0.f ? s.agree * confidence_model->nearness(std::min(y - s.up, s.down - y)) : 0.f;

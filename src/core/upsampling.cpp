@@ -168,8 +168,7 @@ namespace {
 /// verdict on another one in the same pass.
 std::vector<cv::Point> occludedPoints(const ColumnIndex& index, const ScanLines& lines,
                                       const cv::Mat& image, const BIParams& params) {
-  params.validate();
-  requireDisparityMap(lines.disparity, "removeOccludedPoints");
+  params.validate();  // (lines.disparity was checked before the index was built on it)
   if (image.size() != lines.disparity.size()) {
     throw std::invalid_argument("removeOccludedPoints: image size differs from the scan lines");
   }
@@ -193,23 +192,12 @@ std::vector<cv::Point> occludedPoints(const ColumnIndex& index, const ScanLines&
   return removed;
 }
 
-void clearPixels(ScanLines& lines, const std::vector<cv::Point>& pixels) {
-  const bool has_ring_map = !lines.ring.empty();
-  for (const cv::Point& p : pixels) {
-    lines.disparity(p) = 0.f;
-    if (has_ring_map) lines.ring(p) = -1;
-  }
-}
-
 }  // namespace
 
 int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams& params,
                          std::vector<cv::Point>* removed_pixels) {
-  // (lines.disparity is checked before the index is built on it.)
-  requireDisparityMap(lines.disparity, "removeOccludedPoints");
-  std::vector<cv::Point> removed =
-      occludedPoints(ColumnIndex(lines.disparity), lines, image, params);
-  clearPixels(lines, removed);
+  std::vector<cv::Point> removed;
+  removeOccludedPointsIndexed(lines, image, params, removed);  // (the index is not wanted here)
   const int count = static_cast<int>(removed.size());
   if (removed_pixels) *removed_pixels = std::move(removed);
   return count;
@@ -220,7 +208,11 @@ ColumnIndex removeOccludedPointsIndexed(ScanLines& lines, const cv::Mat& image,
   requireDisparityMap(lines.disparity, "removeOccludedPoints");
   ColumnIndex index(lines.disparity);
   removed = occludedPoints(index, lines, image, params);
-  clearPixels(lines, removed);
+  const bool has_ring_map = !lines.ring.empty();
+  for (const cv::Point& p : removed) {
+    lines.disparity(p) = 0.f;
+    if (has_ring_map) lines.ring(p) = -1;
+  }
   index.erase(removed);
   return index;
 }
