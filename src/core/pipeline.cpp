@@ -75,17 +75,16 @@ ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
   v.lines = completeScanLines(sparse, params.bi);
   const ColumnIndex index = removeOccludedPointsIndexed(v.lines, image, params.bi, removed);
   v.removed = static_cast<int>(removed.size());
+  const IntervalConfidence model(params.confidence, v.lines.disparity.size(), removed);
+  IntervalMaps maps;
+  maps.bounds = &v.bounds;
+  maps.confidence = &v.confidence;
   const double margin = params.patchmatch.bound_margin;
-  if (usesBF(params.method)) {
+  if (usesBF(params.method)) {  // BF*'s prior; the bounds and its confidence from the lines
     v.prior = upsampleBF(sparse, params.bf);
-    v.bounds = computeScanLineBounds(index, v.lines.disparity, margin);
-    v.confidence = priorConfidence(index, v.lines.disparity, v.prior, removed, params.confidence);
+    scanLineIntervals(index, v.lines.disparity, 0, margin, &model, maps, &v.prior);
   } else {
-    const IntervalConfidence model(params.confidence, v.lines.disparity.size(), removed);
-    IntervalMaps maps;
     maps.prior = &v.prior;
-    maps.bounds = &v.bounds;
-    maps.confidence = &v.confidence;
     scanLineIntervals(index, v.lines.disparity, params.bi.max_interp_rows, margin, &model, maps);
   }
   if (isFused(params.method) && params.patchmatch.confidence_weighting) {
