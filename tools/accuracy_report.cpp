@@ -56,6 +56,9 @@ Options:
   --stereo-check <px>   dense: keep only the reference pixels where OpenCV's SGBM (the
                         benchmark's) has a disparity within <px> of the reference's, as KITTI's
                         ground truth is cleaned with stereo (0 = off, default; e.g. 3)
+  --keep-unverified     dense: keep other sweeps' points where frame 20's own sweep has none
+                        nearby (above its top beam, its dropouts), as KITTI's ground truth does;
+                        with --stereo-check 3 the reference most like KITTI's
   --help                this text
 )";
 
@@ -63,7 +66,7 @@ struct Options {
   std::string data, params, ip_basic_blur = "gaussian", reference = "nearest";
   double stereo_check_px = 0.0;
   std::set<std::string> methods, layouts;
-  bool middlebury = true, kitti = true, dense = true, kitti_pms = true;
+  bool middlebury = true, kitti = true, dense = true, kitti_pms = true, keep_unverified = false;
   int frames = 0;
 };
 
@@ -93,11 +96,12 @@ Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(argc, argv,
                             {"--data", "--protocols", "--layouts", "--frames", "--params",
                              "--methods", "--ip-basic-blur", "--reference", "--stereo-check"},
-                            {"--no-kitti-pms"});
+                            {"--no-kitti-pms", "--keep-unverified"});
   Options o;
   o.data = cl.value("--data", defaultDataDir());
   o.frames = cl.intValue("--frames", 0, 1, 1000);
   o.kitti_pms = !cl.has("--no-kitti-pms");
+  o.keep_unverified = cl.has("--keep-unverified");
   o.params = cl.value("--params", "");
   o.ip_basic_blur = cl.choice("--ip-basic-blur", "gaussian", {"gaussian", "bilateral", "none"});
   o.reference = cl.choice("--reference", "nearest", {"nearest", "majority"});
@@ -190,22 +194,22 @@ void printKitti(const lsf::AccuracyOptions& options) {
             << (options.kitti_pms ? "" : " (without pms)") << "\n\n";
 }
 
-void printDense(const lsf::AccuracyOptions& options, const std::string& reference,
-                double stereo_check_px) {
+void printDense(const lsf::AccuracyOptions& options, const Options& o) {
   const auto t = std::chrono::steady_clock::now();
   lsf::kitti::AccumulationParams reference_params;
-  if (reference == "majority") {
+  reference_params.keep_unverified = o.keep_unverified;
+  if (o.reference == "majority") {
     reference_params.combine = lsf::kitti::AccumulationParams::Combine::kMajority;
   }
   const lsf::DenseProtocolResult dense =
-      lsf::runDenseProtocol(options, reference_params, stereo_check_px);
+      lsf::runDenseProtocol(options, reference_params, o.stereo_check_px);
   std::cout << "## dense: " << dense.layout.description << "\n\n"
             << lsf::formatKittiLayout(dense.layout)
             << "\nPer depth band of the reference depth:\n\n"
             << lsf::formatDepthBands(dense.layout) << "\nPer region:\n\n"
             << lsf::formatKittiRegions(dense.layout) << "\nThe reference:\n\n"
             << lsf::formatAccumulatedReference(dense.reference)
-            << lsf::formatStereoCheck(dense.stereo_check, stereo_check_px) << "\n";
+            << lsf::formatStereoCheck(dense.stereo_check, o.stereo_check_px) << "\n";
   std::cout << "Dense protocol: " << secondsSince(t) << " s"
             << (options.kitti_pms ? "" : " (without pms)") << "\n";
 }
@@ -221,7 +225,7 @@ int run(const Options& o) {
                "the fill. Regions: see eval/accuracy_protocols.h.\n\n";
   if (o.middlebury) printMiddlebury(options);
   if (o.kitti) printKitti(options);
-  if (o.dense) printDense(options, o.reference, o.stereo_check_px);
+  if (o.dense) printDense(options, o);
   return 0;
 }
 

@@ -64,6 +64,7 @@ DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
       (reference_params.combine == kitti::AccumulationParams::Combine::kMajority
            ? "per pixel the depth most sweeps agree on)"
            : "per pixel the nearest point)") +
+      (reference_params.keep_unverified ? ", points with no own point nearby kept" : "") +
       (stereo_check_px > 0.0
            ? ", kept where SGBM agrees within " + format("%g", stereo_check_px) + " px"
            : std::string());

@@ -135,8 +135,9 @@ std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference)
   out += row({"pixels with a reference (of the image)", share(reference.pixels, image)});
   out += row({"of them with an own-sweep point", share(reference.own_pixels, reference.pixels)});
   out += row({"other sweeps' points in the image", std::to_string(other)});
-  out += row(
-      {"removed: no own point in the check window", share(reference.removed_unverified, other)});
+  out += row({reference.unverified_kept ? "kept unverified: no own point in the check window"
+                                        : "removed: no own point in the check window",
+              share(reference.removed_unverified, other)});
   out += row({"removed: outside the window's own depth range",
               share(reference.removed_disagreeing, other)});
   out += row({"other vs own sweep before removal: relative difference median / p90 %",

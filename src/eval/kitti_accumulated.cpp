@@ -143,6 +143,7 @@ AccumulatedDepth accumulateDepth(const std::vector<PosedSweep>& sweeps, const St
 
   AccumulatedDepth out;
   out.sweeps = static_cast<int>(sweeps.size());
+  out.unverified_kept = params.keep_unverified;
   cv::Mat1f other_raw = emptyDepth(camera), kept = emptyDepth(camera);
   std::vector<cv::Mat1f> layers{own};  // kMajority: one z-buffer per sweep
   const double lo = 1.0 - params.tolerance, hi = 1.0 + params.tolerance;

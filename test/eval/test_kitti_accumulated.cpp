@@ -80,6 +80,8 @@ TEST(AccumulatedDepth, KeepsPointsOnTheOwnSurfaceAndRemovesTheOthers) {
   keep.keep_unverified = true;
   const kitti::AccumulatedDepth kept = kitti::accumulateDepth(sweeps, camera(), keep);
   EXPECT_EQ(kept.removed_unverified, 1);  // still counted
+  EXPECT_TRUE(kept.unverified_kept);
+  EXPECT_FALSE(out.unverified_kept);
   EXPECT_EQ(kept.pixels, out.pixels + 1);
   EXPECT_NEAR(kept.depth(8, 16), 10.f, 1e-5);
 }

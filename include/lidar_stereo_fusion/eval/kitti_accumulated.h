@@ -62,6 +62,7 @@ struct AccumulatedDepth {
   int sweeps = 0;   ///< sweeps accumulated, the own one included
   long other_points = 0;         ///< points of the other sweeps that land in the image in range
   long removed_unverified = 0;   ///< of those: no own point in the check window
+  bool unverified_kept = false;  ///< AccumulationParams::keep_unverified: those were kept
   long removed_disagreeing = 0;  ///< of those: depth outside the window's own depth range
   int own_pixels = 0;            ///< pixels of the own sweep alone
   int pixels = 0;                ///< pixels of the reference
