@@ -1,4 +1,5 @@
 // Per-region masks, the nearest-LiDAR fill and map combination of the accuracy protocols.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -69,6 +70,8 @@ std::string regionName(Region region) {
       return ">= 30 m";
     case Region::kAboveBothViews:
       return "above, both views";
+    case Region::kTopRows:
+      return "rows < " + std::to_string(kTopRowsEnd);
   }
   return "unknown";
 }
@@ -92,6 +95,8 @@ const cv::Mat1b& RegionMasks::mask(Region region) const {
       return far;
     case Region::kAboveBothViews:
       return above_both_views;
+    case Region::kTopRows:
+      return top_rows;
     case Region::kAll:
       break;
   }
@@ -105,6 +110,8 @@ void RegionMasks::setDepthBands(const cv::Mat1f& reference_depth) {
   near = cv::Mat1b(reference_depth.size(), uchar(0));
   mid = near.clone();
   far = near.clone();
+  top_rows = near.clone();
+  top_rows.rowRange(0, std::min(kTopRowsEnd, top_rows.rows)).setTo(255);
   for (int y = 0; y < reference_depth.rows; ++y) {
     for (int x = 0; x < reference_depth.cols; ++x) {
       const float z = reference_depth(y, x);
@@ -151,6 +158,7 @@ RegionMasks computeRegionMasks(const SparseDisparity& fed, const cv::Mat& image,
   masks.mid = masks.near.clone();
   masks.far = masks.near.clone();
   masks.above_both_views = masks.near.clone();
+  masks.top_rows = masks.near.clone();
   return masks;
 }
 

@@ -16,7 +16,8 @@ using table::separator;
 
 const std::vector<Region> kSplitRegions = {Region::kAbove, Region::kAboveBothViews, Region::kInside,
                                            Region::kEdge, Region::kElsewhere};
-const std::vector<Region> kBands = {Region::kAll, Region::kNear, Region::kMid, Region::kFar};
+const std::vector<Region> kBands = {Region::kAll, Region::kNear, Region::kMid, Region::kFar,
+                                    Region::kTopRows};
 
 /// Adds "raw coverage %" and "ms / <item>" (the method's wall time per scene / frame) columns to a
 /// table from report.h (same row order).

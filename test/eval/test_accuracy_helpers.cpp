@@ -125,6 +125,21 @@ TEST(RegionMasks, DepthBandsSplitTheReferenceAtTenAndThirtyMetres) {
   EXPECT_THROW(m.setDepthBands(cv::Mat1f(8, 4, 0.f)), std::invalid_argument);
 }
 
+TEST(RegionMasks, TopRowsAreTheRowsAboveRow150OnceTheBandsAreSet) {
+  RegionMasks m = computeRegionMasks(twoLines(10.f, 13.f), cv::Mat(9, 4, CV_8UC1, 0.0));
+  EXPECT_EQ(cv::countNonZero(m.top_rows), 0);  // empty until the reference is known
+  m.setDepthBands(cv::Mat1f(9, 4, 20.f));
+  EXPECT_EQ(cv::countNonZero(m.top_rows), 9 * 4);  // a 9-row image lies above row 150
+  EXPECT_EQ(&m.mask(Region::kTopRows), &m.top_rows);
+  EXPECT_EQ(regionName(Region::kTopRows), "rows < 150");
+  RegionMasks tall = computeRegionMasks(twoLines(10.f, 13.f), cv::Mat(9, 4, CV_8UC1, 0.0));
+  tall.above = cv::Mat1b(200, 3, uchar(0));  // the bands take the masks' size from `above`
+  tall.setDepthBands(cv::Mat1f(200, 3, 0.f));
+  EXPECT_EQ(cv::countNonZero(tall.top_rows), kTopRowsEnd * 3);
+  EXPECT_EQ(tall.top_rows(kTopRowsEnd - 1, 2), 255);
+  EXPECT_EQ(tall.top_rows(kTopRowsEnd, 0), 0);
+}
+
 TEST(RegionMasks, AboveInBothViewsIsWhereTheMatchLiesInsideTheRightImage) {
   RegionMasks m = computeRegionMasks(twoLines(10.f, 13.f), cv::Mat(9, 4, CV_8UC1, 0.0));
   EXPECT_EQ(cv::countNonZero(m.above_both_views), 0);         // empty until the reference is known

@@ -39,7 +39,9 @@
 //               = |d_up - d_down| [px];
 //  * "elsewhere": inside and not edge.
 // Depth bands (KITTI protocols; empty on Middlebury), by the reference depth z [m]: "< 10 m"
-// (z < 10), "10-30 m" (10 <= z < 30), ">= 30 m" (z >= 30).
+// (z < 10), "10-30 m" (10 <= z < 30), ">= 30 m" (z >= 30); with them "rows < 150" (image rows
+// y < kTopRowsEnd): the rows of a KITTI image above and around the HDL-64E's top beam, the last
+// column of issue 31's table on KITTI's ground truth.
 #pragma once
 
 #include <array>
@@ -58,23 +60,37 @@
 
 namespace lidar_stereo_fusion {
 
-enum class Region { kAll, kAbove, kInside, kEdge, kElsewhere, kNear, kMid, kFar, kAboveBothViews };
-constexpr int kRegionCount = 9;
+enum class Region {
+  kAll,
+  kAbove,
+  kInside,
+  kEdge,
+  kElsewhere,
+  kNear,
+  kMid,
+  kFar,
+  kAboveBothViews,
+  kTopRows
+};
+constexpr int kRegionCount = 10;
 /// The depth bands' limits [m] (kNear: z < kNearBandMax, kFar: z >= kFarBandMin).
 constexpr double kNearBandMax = 10.0;
 constexpr double kFarBandMin = 30.0;
+/// Region::kTopRows: the image rows y < kTopRowsEnd.
+constexpr int kTopRowsEnd = 150;
 /// "all", "above", "inside", "edge", "elsewhere", "< 10 m", "10-30 m", ">= 30 m", "above, both
-/// views".
+/// views", "rows < 150".
 std::string regionName(Region region);
 
 /// Region masks of one image (CV_8U, 255 inside the region); see the file comment.
 struct RegionMasks {
   cv::Mat1b above, inside, edge, elsewhere;
   cv::Mat1b near, mid, far;                    ///< depth bands; all 0 until setDepthBands
+  cv::Mat1b top_rows;                          ///< rows < kTopRowsEnd; all 0 until setDepthBands
   cv::Mat1b above_both_views;                  ///< all 0 until setInBothViews
   const cv::Mat1b& mask(Region region) const;  ///< empty Mat for kAll
   /// Sets the depth bands from a reference depth map [m] (0 / NaN = no reference) of the masks'
-  /// size. Throws std::invalid_argument on a size mismatch.
+  /// size, and top_rows. Throws std::invalid_argument on a size mismatch.
   void setDepthBands(const cv::Mat1f& reference_depth);
   /// Sets above_both_views from the left view's reference disparity [px] (0 / NaN = none) of the
   /// masks' size: the "above" pixels (x, y) with x - d >= 0. Throws std::invalid_argument on a
