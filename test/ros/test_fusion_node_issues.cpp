@@ -233,7 +233,8 @@ TEST_F(FusionNode, KeepRate_DroppedSetsMakeTheSearchCoarserAndTheNodeSaysWhy) {
       ros::WallDuration(0.001).sleep();
     }
     h().waitForOutputs(last, 5.0);
-    said = h().waitForLog(mark, {"keep_rate", "dropped input sets", "step 1 of 3"}, 0.5);
+    said = h().waitForLog(
+        mark, {"keep_rate", "dropped input sets", "step 1 of 6", "search from 1/8 size"}, 0.5);
   }
   ASSERT_TRUE(said) << h().logsSince(mark);
   ASSERT_TRUE(h().stats());

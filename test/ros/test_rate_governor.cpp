@@ -34,23 +34,35 @@ int feed(lsf::RateGovernor& g, int n, double period, double busy_ms, int every,
 
 }  // namespace
 
-TEST(RateGovernor, StepsGoToTheCoarsestLevelThenOneSweep) {
+TEST(RateGovernor, StepsAlternateOneMoreLevelAndACoarserSearchWithoutBoundsThenOneSweep) {
   const auto live = lsf::effortSteps(livePreset());
-  ASSERT_EQ(live.size(), 3u);
-  EXPECT_EQ(live[0].unbounded_scale, 2);
-  EXPECT_EQ(live[0].iterations, 2);
-  EXPECT_EQ(live[1].unbounded_scale, 4);
-  EXPECT_EQ(live[1].iterations, 2);
-  EXPECT_EQ(live[2].unbounded_scale, 4);
-  EXPECT_EQ(live[2].iterations, 1);
-  EXPECT_EQ(live[1].describe(),
-            "pixels without scan-line bounds searched down to 1/4 size, 2 sweeps at the coarsest "
-            "level");
+  ASSERT_EQ(live.size(), 5u);
+  const int levels[] = {2, 3, 2, 3, 3}, coarsest[] = {4, 8, 4, 8, 8};
+  const int unbounded[] = {2, 2, 4, 4, 4}, sweeps[] = {2, 2, 2, 2, 1};
+  for (size_t i = 0; i < live.size(); ++i) {
+    EXPECT_EQ(live[i].coarse_levels, levels[i]) << i;
+    EXPECT_EQ(live[i].coarsest_scale, coarsest[i]) << i;
+    EXPECT_EQ(live[i].unbounded_scale, unbounded[i]) << i;  // never coarser than base's coarsest
+    EXPECT_EQ(live[i].iterations, sweeps[i]) << i;
+  }
+  EXPECT_EQ(live[0].describe(),
+            "search from 1/4 size, pixels without scan-line bounds searched down to 1/2 size, 2 "
+            "sweeps at the coarsest level");
+  EXPECT_EQ(live[3].describe(),
+            "search from 1/8 size, pixels without scan-line bounds searched down to 1/4 size, 2 "
+            "sweeps at the coarsest level");
 
   lsf::FusionParams fusion = livePreset();  // the default preset: every level searches
   fusion.patchmatch.search_scale = 1;
   fusion.patchmatch.unbounded_scale = 1;
-  EXPECT_EQ(lsf::effortSteps(fusion).size(), 4u);  // 1, 2, 4, then one sweep
+  EXPECT_EQ(lsf::effortSteps(fusion).size(), 7u);  // 1, 2, 4, each then one more level; 1 sweep
+
+  lsf::FusionParams deepest = fusion;  // already at the most coarse levels: none is added
+  deepest.patchmatch.coarse_levels = lsf::PatchMatchParams::kMaxCoarseLevels;
+  const auto deep = lsf::effortSteps(deepest);
+  ASSERT_EQ(deep.size(), 6u);  // 1, 2, 4, 8, 16, then one sweep
+  for (const lsf::EffortStep& s : deep) EXPECT_EQ(s.coarse_levels, 4);
+  EXPECT_EQ(deep[4].unbounded_scale, 16);
 
   lsf::FusionParams flat;  // no coarse level: nothing to give up
   flat.patchmatch.coarse_levels = 0;
@@ -93,18 +105,28 @@ TEST(RateGovernor, StepsDownWhenTwoOfTenFramesAreFollowedByDrops) {
   EXPECT_EQ(changes, 1);
   EXPECT_EQ(at, 9);
   EXPECT_EQ(g.step(), 1);
-  EXPECT_EQ(g.params().patchmatch.unbounded_scale, 4);
+  EXPECT_EQ(g.params().patchmatch.coarse_levels, 3);
+  EXPECT_EQ(g.params().patchmatch.unbounded_scale, 2);
   EXPECT_EQ(g.params().patchmatch.iterations, 2);
   EXPECT_EQ(g.params().patchmatch.search_scale, 2);  // the rest as configured
+  EXPECT_NO_THROW(g.params().validate());
   EXPECT_EQ(g.reason(),
             "2 of the last 10 frames were followed by dropped input sets (frames take 130 ms, "
             "median, input every 100 ms)");
-  // Still late at step 1: step 2 after another full window, then no further step exists.
+  // Still late: one step per full window down to the last, then no further step exists.
   EXPECT_EQ(feed(g, 10, 0.1, 110.0, 5), 1);
   EXPECT_EQ(g.step(), 2);
+  EXPECT_EQ(g.params().patchmatch.coarse_levels, 2);  // the configured levels again
+  EXPECT_EQ(g.params().patchmatch.unbounded_scale, 4);
+  EXPECT_EQ(g.params().patchmatch.iterations, 2);
+  EXPECT_EQ(feed(g, 20, 0.1, 108.0, 5), 2);
+  EXPECT_EQ(g.step(), 4);
+  EXPECT_EQ(g.params().patchmatch.coarse_levels, 3);
+  EXPECT_EQ(g.params().patchmatch.unbounded_scale, 4);
   EXPECT_EQ(g.params().patchmatch.iterations, 1);
+  EXPECT_NO_THROW(g.params().validate());
   EXPECT_EQ(feed(g, 50, 0.1, 105.0, 5), 0);
-  EXPECT_EQ(g.step(), 2);
+  EXPECT_EQ(g.step(), 4);
 }
 
 TEST(RateGovernor, StepsBackUpOnlyWhenTheFinerStepIsPredictedToFit) {
@@ -138,7 +160,7 @@ TEST(RateGovernor, ARebaseStartsFromTheNewSearch) {
   g.rebase(changed);
   EXPECT_EQ(g.step(), 0);
   EXPECT_EQ(g.params().patchmatch.iterations, 3);
-  EXPECT_EQ(g.steps(), 3);
+  EXPECT_EQ(g.steps(), 5);
 }
 
 TEST(RateGovernor, AnUnknownPeriodStepsDownButNeverUp) {
