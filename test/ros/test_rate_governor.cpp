@@ -34,16 +34,16 @@ int feed(lsf::RateGovernor& g, int n, double period, double busy_ms, int every,
 
 }  // namespace
 
-TEST(RateGovernor, StepsAlternateOneMoreLevelAndACoarserSearchWithoutBoundsThenOneSweep) {
+TEST(RateGovernor, StepsAlternateOneMoreLevelAndACoarserSearchWithoutBounds) {
   const auto live = lsf::effortSteps(livePreset());
-  ASSERT_EQ(live.size(), 5u);
-  const int levels[] = {2, 3, 2, 3, 3}, coarsest[] = {4, 8, 4, 8, 8};
-  const int unbounded[] = {2, 2, 4, 4, 4}, sweeps[] = {2, 2, 2, 2, 1};
+  ASSERT_EQ(live.size(), 4u);
+  const int levels[] = {2, 3, 2, 3}, coarsest[] = {4, 8, 4, 8};
+  const int unbounded[] = {2, 2, 4, 4};
   for (size_t i = 0; i < live.size(); ++i) {
     EXPECT_EQ(live[i].coarse_levels, levels[i]) << i;
     EXPECT_EQ(live[i].coarsest_scale, coarsest[i]) << i;
     EXPECT_EQ(live[i].unbounded_scale, unbounded[i]) << i;  // never coarser than base's coarsest
-    EXPECT_EQ(live[i].iterations, sweeps[i]) << i;
+    EXPECT_EQ(live[i].iterations, 2) << i;  // one sweep only where no level can be added
   }
   EXPECT_EQ(live[0].describe(),
             "search from 1/4 size, pixels without scan-line bounds searched down to 1/2 size, 2 "
@@ -55,7 +55,7 @@ TEST(RateGovernor, StepsAlternateOneMoreLevelAndACoarserSearchWithoutBoundsThenO
   lsf::FusionParams fusion = livePreset();  // the default preset: every level searches
   fusion.patchmatch.search_scale = 1;
   fusion.patchmatch.unbounded_scale = 1;
-  EXPECT_EQ(lsf::effortSteps(fusion).size(), 7u);  // 1, 2, 4, each then one more level; 1 sweep
+  EXPECT_EQ(lsf::effortSteps(fusion).size(), 6u);  // 1, 2, 4, each then one more level
 
   lsf::FusionParams deepest = fusion;  // already at the most coarse levels: none is added
   deepest.patchmatch.coarse_levels = lsf::PatchMatchParams::kMaxCoarseLevels;
@@ -118,15 +118,14 @@ TEST(RateGovernor, StepsDownWhenTwoOfTenFramesAreFollowedByDrops) {
   EXPECT_EQ(g.step(), 2);
   EXPECT_EQ(g.params().patchmatch.coarse_levels, 2);  // the configured levels again
   EXPECT_EQ(g.params().patchmatch.unbounded_scale, 4);
-  EXPECT_EQ(g.params().patchmatch.iterations, 2);
-  EXPECT_EQ(feed(g, 20, 0.1, 108.0, 5), 2);
-  EXPECT_EQ(g.step(), 4);
+  EXPECT_EQ(feed(g, 10, 0.1, 108.0, 5), 1);
+  EXPECT_EQ(g.step(), 3);
   EXPECT_EQ(g.params().patchmatch.coarse_levels, 3);
   EXPECT_EQ(g.params().patchmatch.unbounded_scale, 4);
-  EXPECT_EQ(g.params().patchmatch.iterations, 1);
+  EXPECT_EQ(g.params().patchmatch.iterations, 2);
   EXPECT_NO_THROW(g.params().validate());
   EXPECT_EQ(feed(g, 50, 0.1, 105.0, 5), 0);
-  EXPECT_EQ(g.step(), 4);
+  EXPECT_EQ(g.step(), 3);
 }
 
 TEST(RateGovernor, StepsBackUpOnlyWhenTheFinerStepIsPredictedToFit) {
@@ -160,7 +159,7 @@ TEST(RateGovernor, ARebaseStartsFromTheNewSearch) {
   g.rebase(changed);
   EXPECT_EQ(g.step(), 0);
   EXPECT_EQ(g.params().patchmatch.iterations, 3);
-  EXPECT_EQ(g.steps(), 5);
+  EXPECT_EQ(g.steps(), 4);
 }
 
 TEST(RateGovernor, AnUnknownPeriodStepsDownButNeverUp) {

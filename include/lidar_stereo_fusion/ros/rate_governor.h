@@ -13,7 +13,8 @@
 //   2. back to the configured levels, pixels without bounds searched no finer than the next
 //      coarser level (unbounded_scale times coarse_scale); then again one more level; and so on
 //      up to the configured coarsest level;
-//   3. the coarsest level sweeps the left view once (iterations 1).
+//   3. where no level can be added (coarse_levels at its maximum), the coarsest level sweeps the
+//      left view once (iterations 1).
 // `live`, KITTI frame 0: 1.00x SGBM (ring hold-out 999 mm, Middlebury lower 2/3 0.343 px), one
 // more level 0.80x (983 mm, 0.431 px), pixels without bounds at 1/4 0.74x (1024 mm, 0.486 px),
 // both 0.58x (994 mm, 0.586 px).
@@ -44,11 +45,11 @@ struct EffortStep {
 /// The steps for `base`: its own search first (pixels without bounds searched down to the finer
 /// of unbounded_scale and search_scale, u), then the same with one more coarse level (unless
 /// base has PatchMatchParams::kMaxCoarseLevels), then u times coarse_scale with base's levels and
-/// with one more, and so on up to base's coarsest level (coarse_scale^coarse_levels), then one
-/// sweep at the coarsest level if base has more. A method that is not fused (no scan-line bounds
-/// to search by) or a base without coarse levels has one step. (A level is only added where the
-/// image is large enough, PatchMatchStereo::compute: on a small image such a step costs what the
-/// one before did.)
+/// with one more, and so on up to base's coarsest level (coarse_scale^coarse_levels); without the
+/// added level, last one sweep at the coarsest level if base has more. A method that is not fused
+/// (no scan-line bounds to search by) or a base without coarse levels has one step. (A level is
+/// only added where the image is large enough, PatchMatchStereo::compute: on a small image such a
+/// step costs what the one before did.)
 std::vector<EffortStep> effortSteps(const FusionParams& base);
 
 class RateGovernor {
