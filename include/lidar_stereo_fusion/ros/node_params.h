@@ -93,10 +93,10 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, NodeParams>> visitParams(P&& p,
               g,
               {},
               "",
-              "When input sets are dropped because the worker is busy, search less above the "
-              "LiDAR (pixels without scan-line bounds at a coarser level, then one coarse sweep) "
-              "until the frames fit the input's rate again; warned and in diagnostics (true in "
-              "fusion.launch with preset:=live)",
+              "When input sets are dropped because the worker is busy, search less, mostly "
+              "above the LiDAR (one more coarse level, pixels without scan-line bounds at a "
+              "coarser level, both) until the frames fit the input's rate again; warned and in "
+              "diagnostics (true in fusion.launch with preset:=live)",
               "",
               kStartup},
     p.keep_rate);
