@@ -5,21 +5,13 @@
 #include <gtest/gtest.h>
 
 #include "lidar_stereo_fusion/core/metrics.h"
+#include "test_scenes.h"
 
 namespace lidar_stereo_fusion {
 namespace {
 
 /// fx * B = 100 px m.
-StereoCamera camera(int width, int height) {
-  StereoCamera c;
-  c.fx = c.fy = 200.0;
-  c.cx = width / 2.0;
-  c.cy = height / 2.0;
-  c.baseline = 0.5;
-  c.width = width;
-  c.height = height;
-  return c;
-}
+StereoCamera camera(int width, int height) { return test::centredCamera(width, height, 200.0); }
 
 TEST(DepthMetrics, MaeRmseAndInverseErrorsOverReferencePixelsMissingCountsAsZeroDepth) {
   const cv::Mat1f reference = (cv::Mat1f(2, 3) << 10, 20, 0, 5, 25, 50);

@@ -8,8 +8,23 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidar_stereo_fusion/core/types.h"
+
 namespace lidar_stereo_fusion {
 namespace test {
+
+/// A w x h rectified camera with square pixels, the principal point in the middle and a 0.5 m
+/// baseline: fx * baseline = fx / 2 px m.
+inline StereoCamera centredCamera(int w, int h, double fx) {
+  StereoCamera c;
+  c.fx = c.fy = fx;
+  c.cx = w / 2.0;
+  c.cy = h / 2.0;
+  c.baseline = 0.5;
+  c.width = w;
+  c.height = h;
+  return c;
+}
 
 /// A smooth, non-periodic colour texture T(u, v): a sum of random sinusoids per channel
 /// (wavelengths 6..40 px), evaluated analytically so that any sub-pixel position is exact.

@@ -8,6 +8,7 @@
 #include "lidar_stereo_fusion/core/pipeline.h"
 #include "lidar_stereo_fusion/core/prior_confidence.h"
 #include "lidar_stereo_fusion/core/upsampling.h"
+#include "test_scenes.h"
 
 namespace lsf = lidar_stereo_fusion;
 
@@ -49,13 +50,7 @@ TEST(StageTwoOnePass, PipelinePriorAndConfidenceEqualThePublicStepsBitForBit) {
   params.bi.max_interp_rows = 8;
   params.bi.max_gap_px = 1;  // keep the ring gaps of scene()
   const cv::Mat image(kHeight, kWidth, CV_8UC3, cv::Scalar(90, 90, 90));
-  lsf::StereoCamera camera;
-  camera.fx = camera.fy = 100.0;
-  camera.cx = kWidth / 2.0;
-  camera.cy = kHeight / 2.0;
-  camera.baseline = 0.5;
-  camera.width = kWidth;
-  camera.height = kHeight;
+  const lsf::StereoCamera camera = lsf::test::centredCamera(kWidth, kHeight, 100.0);
   lsf::FusionPipeline pipeline(params);
   const lsf::FusionResult r =
       pipeline.processSparse(image, image, scene(), lsf::SparseDisparity(), camera);

@@ -4,6 +4,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/test_scenes.h"
 #include "lidar_stereo_fusion/core/types.h"
 
 namespace lidar_stereo_fusion {
@@ -11,16 +12,7 @@ namespace test {
 
 /// A w x h camera with the principal point in the middle; fx * baseline = 50 px m (z = 10 m is
 /// 5 px, 25 m is 2 px).
-inline StereoCamera camera(int w, int h) {
-  StereoCamera c;
-  c.fx = c.fy = 100.0;
-  c.cx = w / 2.0;
-  c.cy = h / 2.0;
-  c.baseline = 0.5;
-  c.width = w;
-  c.height = h;
-  return c;
-}
+inline StereoCamera camera(int w, int h) { return centredCamera(w, h, 100.0); }
 
 /// Random texture (fixed seed): the right image is the left shifted by `shift` px (a
 /// fronto-parallel plane at disparity `shift`), 0 where the left has no match.
