@@ -54,8 +54,8 @@ std::vector<EffortStep> effortSteps(const FusionParams& base) {
   }
   // One sweep at the coarsest level, where no level could be added: at 1/8 size the coarsest
   // level's sweeps cost little, and one sweep there doubles the error above the LiDAR (synthetic
-  // street, `live`: 0.58x -> 0.56x SGBM, 1.5 -> 2.7 px; 1/4 size: 0.74x -> 0.69x).
-  s = steps.back();
+  // street, `live`: 0.58x -> 0.56x SGBM, 1.5 -> 2.7 px; 1/4 size: 0.74x -> 0.69x). Without an
+  // added level, `s` is the last step.
   if (!extra_level && s.iterations > 1) {
     s.iterations = 1;
     steps.push_back(s);
