@@ -1,7 +1,8 @@
 // accuracy_report: every method on every accuracy protocol (Middlebury pseudo-LiDAR layouts, KITTI
-// ring hold-out, KITTI dense LiDAR against an accumulated reference), with per-region figures, as
-// Markdown tables. The protocols themselves are in eval/accuracy_protocols.h and
-// eval/accuracy_dense.h; this tool parses options and prints.
+// ring hold-out, KITTI dense LiDAR against an accumulated reference, the same on the synthetic
+// street against exact and LiDAR-made references), with per-region figures, as Markdown tables.
+// The protocols themselves are in eval/accuracy_protocols.h, eval/accuracy_dense.h and
+// eval/synthetic_dense.h; this tool parses options and prints.
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "lidar_stereo_fusion/eval/accuracy_dense.h"
 #include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 #include "lidar_stereo_fusion/eval/accuracy_tables.h"
+#include "lidar_stereo_fusion/eval/synthetic_dense.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
 #include "lidar_stereo_fusion/io/simd_env.h"
@@ -36,15 +38,22 @@ KITTI devkit (interpolateBackground) before scoring.
     points are the reference depth.
   dense: drive 0009 frame 20: the full sweep fed, scored against the depth accumulated from
     sweeps 15-25 with the OXTS poses (points disagreeing with frame 20's sweep removed).
+  synthetic: the synthetic street (seeds 1-3, frame 5, no data files), the full 64-ring sweep
+    fed: syn_lidar scores against a reference made of LiDAR returns as KITTI's is (sweeps of
+    frames 0-10, the nearest point per pixel, each return widened by its beam's footprint),
+    syn_exact against the exact depth at the same pixels: the same outputs, so the two show
+    what a LiDAR-made reference does to each method's score.
 
 Options:
   --data <dir>          the shared data folder (default: env LSF_DATA_DIR, else the build's
                         ../shared/data next to the source tree)
-  --protocols <list>    comma-separated subset of middlebury,kitti,dense (default all)
-  --layouts <list>      comma-separated subset of mb64,mb16,mb42low,ring32,ring16,dense (default
-                        all); a protocol runs only when one of its layouts is chosen
+  --protocols <list>    comma-separated subset of middlebury,kitti,dense,synthetic (default all)
+  --layouts <list>      comma-separated subset of mb64,mb16,mb42low,ring32,ring16,dense,
+                        syn_exact,syn_lidar (default all); a protocol runs only when one of its
+                        layouts is chosen
   --frames N            the first N KITTI ring hold-out frames (default all 11)
-  --no-kitti-pms        skip pms and "lidar_bi else pms" on KITTI, ring and dense (~15 s a frame)
+  --no-kitti-pms        skip pms and "lidar_bi else pms" on KITTI, ring and dense, and on the
+                        synthetic street (~15 s a frame)
   --params <yaml>       parameters of the "fused" row (and the base of lidar_*, pms), e.g. to
                         compare a tuning against the defaults; default FusionParams()
   --methods <list>      comma-separated subset of the rows: fused, paper, lidar_bi, lidar_bf, pms,
@@ -66,7 +75,8 @@ struct Options {
   std::string data, params, ip_basic_blur = "gaussian", reference = "nearest";
   double stereo_check_px = 0.0;
   std::set<std::string> methods, layouts;
-  bool middlebury = true, kitti = true, dense = true, kitti_pms = true, keep_unverified = false;
+  bool middlebury = true, kitti = true, dense = true, synthetic = true, kitti_pms = true;
+  bool keep_unverified = false;
   int frames = 0;
 };
 
@@ -111,13 +121,15 @@ Options parseOptions(int argc, char** argv) {
   for (const std::string& layout : o.layouts) {
     if (!anyChosen({layout}, lsf::middleburyLayoutNames()) &&
         !anyChosen({layout}, lsf::kittiLayoutNames()) &&
-        !anyChosen({layout}, lsf::denseLayoutNames())) {
-      throw lsf::UsageError("--layouts: unknown layout '" + layout +
-                            "' (valid: mb64, mb16, mb42low, ring32, ring16, dense)");
+        !anyChosen({layout}, lsf::denseLayoutNames()) &&
+        !anyChosen({layout}, lsf::syntheticLayoutNames())) {
+      throw lsf::UsageError(
+          "--layouts: unknown layout '" + layout +
+          "' (valid: mb64, mb16, mb42low, ring32, ring16, dense, syn_exact, syn_lidar)");
     }
   }
   if (cl.has("--protocols")) {
-    o.middlebury = o.kitti = o.dense = false;
+    o.middlebury = o.kitti = o.dense = o.synthetic = false;
     for (const std::string& item : splitList(cl.value("--protocols"))) {
       if (item == "middlebury") {
         o.middlebury = true;
@@ -125,16 +137,19 @@ Options parseOptions(int argc, char** argv) {
         o.kitti = true;
       } else if (item == "dense") {
         o.dense = true;
+      } else if (item == "synthetic") {
+        o.synthetic = true;
       } else {
         throw lsf::UsageError("--protocols: unknown protocol '" + item +
-                              "' (valid: middlebury, kitti, dense)");
+                              "' (valid: middlebury, kitti, dense, synthetic)");
       }
     }
   }
   o.middlebury = o.middlebury && anyChosen(o.layouts, lsf::middleburyLayoutNames());
   o.kitti = o.kitti && anyChosen(o.layouts, lsf::kittiLayoutNames());
   o.dense = o.dense && anyChosen(o.layouts, lsf::denseLayoutNames());
-  if (!o.middlebury && !o.kitti && !o.dense) {
+  o.synthetic = o.synthetic && anyChosen(o.layouts, lsf::syntheticLayoutNames());
+  if (!o.middlebury && !o.kitti && !o.dense && !o.synthetic) {
     throw lsf::UsageError(
         "--protocols and --layouts leave nothing to run (no chosen layout "
         "belongs to a chosen protocol)");
@@ -214,8 +229,21 @@ void printDense(const lsf::AccuracyOptions& options, const Options& o) {
             << (options.kitti_pms ? "" : " (without pms)") << "\n";
 }
 
+void printSynthetic(const lsf::AccuracyOptions& options) {
+  const auto t = std::chrono::steady_clock::now();
+  for (const auto& layout : lsf::runSyntheticDenseProtocol(options)) {
+    std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
+              << lsf::formatKittiLayout(layout) << "\nPer depth band (mean of seeds):\n\n"
+              << lsf::formatDepthBands(layout) << "\nPer region (mean of seeds):\n\n"
+              << lsf::formatKittiRegions(layout) << "\n";
+  }
+  std::cout << "Synthetic dense protocol: " << secondsSince(t) << " s"
+            << (options.kitti_pms ? "" : " (without pms)") << "\n";
+}
+
 int run(const Options& o) {
-  if (!std::filesystem::is_directory(o.data)) {
+  // The synthetic street reads no data folder.
+  if ((o.middlebury || o.kitti || o.dense) && !std::filesystem::is_directory(o.data)) {
     throw std::runtime_error("data folder not found: " + o.data +
                              " (pass --data <dir> or set LSF_DATA_DIR)");
   }
@@ -226,6 +254,7 @@ int run(const Options& o) {
   if (o.middlebury) printMiddlebury(options);
   if (o.kitti) printKitti(options);
   if (o.dense) printDense(options, o);
+  if (o.synthetic) printSynthetic(options);
   return 0;
 }
 

@@ -92,17 +92,19 @@ std::vector<std::pair<std::string, FusionParams>> pipelineRows(const AccuracyOpt
 void scoreDepthCase(const DepthCase& c, const AccuracyOptions& options,
                     const std::vector<std::pair<std::string, FusionParams>>& rows, PmsRun& pms,
                     LayoutAccumulator<DepthMetrics>& acc) {
+  scoreDepthCaseAgainst(c, {{c.reference, acc}}, options, rows, pms);
+}
+
+void scoreDepthCaseAgainst(const DepthCase& c, const std::vector<DepthTarget>& targets,
+                           const AccuracyOptions& options,
+                           const std::vector<std::pair<std::string, FusionParams>>& rows,
+                           PmsRun& pms) {
   const StereoCamera& camera = c.calib.camera;
   const FusionInput input{c.frame.left, c.frame.right, c.fed, c.calib.T_cam_velo, camera};
   const SparseDisparity fed =
       projectCloud(c.fed, c.calib.T_cam_velo, camera, options.fused.projection, View::kLeft);
-  RegionMasks masks = computeRegionMasks(fed, c.frame.left);
-  masks.setDepthBands(c.reference);
-  masks.setInBothViews(depthToDisparity(c.reference, camera));
-  const auto add = [&](const std::string& name, const cv::Mat1f& depth, double seconds) {
-    acc.add(name, scoreRegions(depth, c.reference, masks, camera), rawCoverage(depth, c.reference),
-            seconds);
-  };
+  // Each row's depth and time, in the order the rows are added to the tables.
+  std::vector<std::pair<std::string, std::pair<cv::Mat1f, double>>> runs;
   std::map<std::string, cv::Mat1f> depth;
   for (const auto& [name, params] : rows) {
     const auto t = Clock::now();
@@ -113,21 +115,32 @@ void scoreDepthCase(const DepthCase& c, const AccuracyOptions& options,
       depth[name] = pipeline.process(input).depth;
       if (name == "pms") pms = {depth[name], secondsSince(t)};
     }
-    if (wantedRow(options, name))
-      add(name, depth[name], name == "pms" ? pms.seconds : secondsSince(t));
+    if (wantedRow(options, name)) {
+      runs.push_back({name, {depth[name], name == "pms" ? pms.seconds : secondsSince(t)}});
+    }
   }
   if (depth.count("pms") > 0 && wantedRow(options, kLidarElsePms)) {
-    add(kLidarElsePms, combineMaps(depth.at("lidar_bi"), depth.at("pms")), 0.0);
+    runs.push_back({kLidarElsePms, {combineMaps(depth.at("lidar_bi"), depth.at("pms")), 0.0}});
   }
   if (wantedRow(options, kNearest)) {
     const auto t = Clock::now();
     const cv::Mat1f nearest = disparityToDepth(nearestFill(fed.disparity), camera);
-    add(kNearest, nearest, secondsSince(t));
+    runs.push_back({kNearest, {nearest, secondsSince(t)}});
   }
   if (wantedRow(options, kIpBasic)) {
     const auto t = Clock::now();
     const cv::Mat1f filled = ipBasicFill(disparityToDepth(fed.disparity, camera), options.ip_basic);
-    add(kIpBasic, filled, secondsSince(t));
+    runs.push_back({kIpBasic, {filled, secondsSince(t)}});
+  }
+  const RegionMasks fed_masks = computeRegionMasks(fed, c.frame.left);
+  for (const DepthTarget& target : targets) {
+    RegionMasks masks = fed_masks;
+    masks.setDepthBands(target.reference);
+    masks.setInBothViews(depthToDisparity(target.reference, camera));
+    for (const auto& [name, run] : runs) {
+      target.acc.add(name, scoreRegions(run.first, target.reference, masks, camera),
+                     rawCoverage(run.first, target.reference), run.second);
+    }
   }
 }
 

@@ -102,5 +102,18 @@ void scoreDepthCase(const DepthCase& c, const AccuracyOptions& options,
                     const std::vector<std::pair<std::string, FusionParams>>& rows, PmsRun& pms,
                     LayoutAccumulator<DepthMetrics>& acc);
 
+/// A reference depth [m] and the accumulator of the layout it scores.
+struct DepthTarget {
+  const cv::Mat1f& reference;
+  LayoutAccumulator<DepthMetrics>& acc;
+};
+
+/// scoreDepthCase against several references of the same frame and fed cloud: every row runs
+/// once and is scored against each (c.reference is not read).
+void scoreDepthCaseAgainst(const DepthCase& c, const std::vector<DepthTarget>& targets,
+                           const AccuracyOptions& options,
+                           const std::vector<std::pair<std::string, FusionParams>>& rows,
+                           PmsRun& pms);
+
 }  // namespace accuracy_detail
 }  // namespace lidar_stereo_fusion

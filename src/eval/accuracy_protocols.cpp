@@ -124,6 +124,7 @@ std::vector<std::string> accuracyMethodNames() {
 std::vector<std::string> middleburyLayoutNames() { return {"mb64", "mb16", "mb42low"}; }
 std::vector<std::string> kittiLayoutNames() { return {"ring32", "ring16"}; }
 std::vector<std::string> denseLayoutNames() { return {"dense"}; }
+std::vector<std::string> syntheticLayoutNames() { return {"syn_exact", "syn_lidar"}; }
 
 void AccuracyOptions::validate() const {
   for (const std::string& m : methods) {
@@ -135,9 +136,10 @@ void AccuracyOptions::validate() const {
   }
   for (const std::string& l : layouts) {
     if (!contains(middleburyLayoutNames(), l) && !contains(kittiLayoutNames(), l) &&
-        !contains(denseLayoutNames(), l)) {
-      throw std::invalid_argument("AccuracyOptions: unknown layout '" + l +
-                                  "' (valid: mb64, mb16, mb42low, ring32, ring16, dense)");
+        !contains(denseLayoutNames(), l) && !contains(syntheticLayoutNames(), l)) {
+      throw std::invalid_argument(
+          "AccuracyOptions: unknown layout '" + l +
+          "' (valid: mb64, mb16, mb42low, ring32, ring16, dense, syn_exact, syn_lidar)");
     }
   }
   if (kitti_frames < 0) throw std::invalid_argument("AccuracyOptions: kitti_frames must be >= 0");

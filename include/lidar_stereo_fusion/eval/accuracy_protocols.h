@@ -133,7 +133,7 @@ struct MethodScores {
 /// One layout (a pseudo-LiDAR of a given density, a ring subset) of one protocol.
 template <typename Metrics>
 struct LayoutScores {
-  std::string name;                ///< "mb64", "mb16", "mb42low", "ring32", "ring16", "dense"
+  std::string name;                ///< "mb64", ..., "ring16", "dense", "syn_exact", "syn_lidar"
   std::string description;         ///< one line for the table title
   std::vector<std::string> items;  ///< scene or frame names
   std::vector<MethodScores<Metrics>> methods;
@@ -169,6 +169,7 @@ std::vector<std::string> accuracyMethodNames();
 std::vector<std::string> middleburyLayoutNames();
 std::vector<std::string> kittiLayoutNames();
 std::vector<std::string> denseLayoutNames();
+std::vector<std::string> syntheticLayoutNames();  ///< eval/synthetic_dense.h
 
 /// Middlebury pseudo-LiDAR of a layout ("mb64", "mb16", "mb42low") for a ground-truth map [px].
 /// Throws std::invalid_argument for an unknown layout.
