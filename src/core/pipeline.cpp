@@ -2,6 +2,7 @@
 #include "lidar_stereo_fusion/core/pipeline.h"
 
 #include <chrono>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -67,13 +68,19 @@ struct ViewPrior {
 };
 
 ViewPrior upsampleView(const SparseDisparity& sparse, const cv::Mat& image,
-                       const FusionParams& params) {
+                       const FusionParams& params, const StereoCamera& camera,
+                       const std::optional<Eigen::Vector3d>& lidar_origin) {
   ViewPrior v;
   std::vector<cv::Point> removed;
   // upsampleBI's steps, with one column index for Algorithm 1, Eq. 3, the bounds and the
   // confidence, and BI*'s three maps in one pass.
   v.lines = completeScanLines(sparse, params.bi);
-  const ColumnIndex index = removeOccludedPointsIndexed(v.lines, image, params.bi, removed);
+  ColumnIndex index = removeOccludedPointsIndexed(v.lines, image, params.bi, removed);
+  // The pixels step 2b clears are left to the images: LiDAR-only BI* keeps them (without images
+  // Eq. 3 would blend the two lines there; ring hold-out 32 rings 1102 -> 1113 mm).
+  if (lidar_origin && isFused(params.method)) {
+    removeParallaxHiddenIndexed(v.lines, index, camera, *lidar_origin, params.bi, removed);
+  }
   v.removed = static_cast<int>(removed.size());
   const IntervalConfidence model(params.confidence, v.lines.disparity.size(), removed);
   IntervalMaps maps;
@@ -211,7 +218,8 @@ FusionResult FusionPipeline::process(const FusionInput& input) {
         " in front of the camera): check the cloud and the LiDAR->camera transform");
   }
   const double projection_ms = msSince(t);
-  FusionResult result = runStages(input.left, input.right, left_sparse, right_sparse, input.camera);
+  FusionResult result = runStages(input.left, input.right, left_sparse, right_sparse, input.camera,
+                                  input.T_cam_lidar.translation());
   result.stats.projection_ms = projection_ms;
   result.stats.total_ms = msSince(start);
   return result;
@@ -230,7 +238,7 @@ FusionResult FusionPipeline::processSparse(const cv::Mat& left, const cv::Mat& r
     throw std::invalid_argument("right sparse disparity size differs from the image size");
   }
   const auto start = Clock::now();
-  FusionResult result = runStages(left, right, left_sparse, right_sparse, camera);
+  FusionResult result = runStages(left, right, left_sparse, right_sparse, camera, std::nullopt);
   result.stats.total_ms = msSince(start);
   return result;
 }
@@ -238,7 +246,8 @@ FusionResult FusionPipeline::processSparse(const cv::Mat& left, const cv::Mat& r
 FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat& right_image,
                                        const SparseDisparity& left_sparse,
                                        const SparseDisparity& right_sparse,
-                                       const StereoCamera& camera) {
+                                       const StereoCamera& camera,
+                                       const std::optional<Eigen::Vector3d>& lidar_origin) {
   const Method method = params_.method;
   FusionResult result;
   FrameStats& stats = result.stats;
@@ -252,15 +261,20 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
   ViewPrior left_prior, right_prior;
   const auto left_view = [&] {
     if (!usesLidar(method)) return;
-    left_prior = upsampleView(left_sparse, left_image, params_);
+    left_prior = upsampleView(left_sparse, left_image, params_, camera, lidar_origin);
     stats.points_removed = left_prior.removed;
     result.prior = left_prior.prior;
     result.confidence = left_prior.confidence;
     stats.prior_coverage = coverage(result.prior);
   };
   if (fused) {  // the right view's prior is made beside the left's
-    bothViews(viewThreads(params_), left_view,
-              [&] { right_prior = upsampleView(right_sparse, right_image, params_); });
+    bothViews(viewThreads(params_), left_view, [&] {
+      // The right camera sits baseline to the left camera's right: the same origin,
+      // baseline nearer its x = 0.
+      std::optional<Eigen::Vector3d> right_origin = lidar_origin;
+      if (right_origin) right_origin->x() -= camera.baseline;
+      right_prior = upsampleView(right_sparse, right_image, params_, camera, right_origin);
+    });
   } else {
     left_view();
   }

@@ -20,6 +20,13 @@ namespace lidar_stereo_fusion {
 ColumnIndex removeOccludedPointsIndexed(ScanLines& lines, const cv::Mat& image,
                                         const BIParams& params, std::vector<cv::Point>& removed);
 
+/// removeParallaxHidden (upsampling.h) on `index` (that of `lines`): clears the pixels, erases
+/// them from the index and merges them into `removed` (ordered by column, then row, as Algorithm
+/// 1 leaves it).
+void removeParallaxHiddenIndexed(ScanLines& lines, ColumnIndex& index, const StereoCamera& camera,
+                                 const Eigen::Vector3d& lidar_origin, const BIParams& params,
+                                 std::vector<cv::Point>& removed);
+
 cv::Mat1f interpolateBetweenScanLines(const ColumnIndex& index, const cv::Mat1f& lines,
                                       const BIParams& params);
 

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -215,6 +216,80 @@ ColumnIndex removeOccludedPointsIndexed(ScanLines& lines, const cv::Mat& image,
   }
   index.erase(removed);
   return index;
+}
+
+namespace {
+
+/// The pixels removeParallaxHidden clears, ordered by column, then row; every decision on the
+/// input state (as Algorithm 1's).
+std::vector<cv::Point> parallaxHiddenPixels(const ColumnIndex& index, const StereoCamera& camera,
+                                            const Eigen::Vector3d& o, const BIParams& params) {
+  std::vector<cv::Point> hidden;
+  const double fb = camera.fx * camera.baseline;
+  for (int x = 0; x < index.cols(); ++x) {
+    const ColumnEntry* e = index.column(x);
+    const int n = index.size(x);
+    for (int k = 0; k < n; ++k) {
+      for (const int side : {-1, 1}) {  // q above, then below p = e[k]
+        const int j = k + side;
+        if (j < 0 || j >= n || e[j].d - e[k].d <= params.max_disp_diff) continue;
+        const double zp = fb / e[k].d, zq = fb / e[j].d;
+        if (!(zp > o.z()) || !(zq > o.z())) continue;  // in front of the LiDAR along z
+        // The LiDAR's ray to p at q's depth: o + s (P - o) with z = zq.
+        const double py = (e[k].y - camera.cy) * zp / camera.fy;
+        const double ray_y = o.y() + (zq - o.z()) / (zp - o.z()) * (py - o.y());
+        const double ray_row = camera.cy + camera.fy * ray_y / zq;
+        // Rows from p to where the ray lands, on the far side of p from q; q's edge lies between
+        // that row and q's, p is hidden when the edge passes p.
+        const double beyond = side > 0 ? e[k].y - ray_row : ray_row - e[k].y;
+        if (beyond >= std::abs(e[j].y - e[k].y)) {
+          hidden.emplace_back(x, e[k].y);
+          break;
+        }
+      }
+    }
+  }
+  return hidden;
+}
+
+}  // namespace
+
+void removeParallaxHiddenIndexed(ScanLines& lines, ColumnIndex& index, const StereoCamera& camera,
+                                 const Eigen::Vector3d& lidar_origin, const BIParams& params,
+                                 std::vector<cv::Point>& removed) {
+  if (!params.remove_parallax_hidden) return;
+  camera.validate();
+  if (!lidar_origin.allFinite()) {
+    throw std::invalid_argument("removeParallaxHidden: the LiDAR's origin is not finite");
+  }
+  const std::vector<cv::Point> hidden = parallaxHiddenPixels(index, camera, lidar_origin, params);
+  if (hidden.empty()) return;
+  const bool has_ring_map = !lines.ring.empty();
+  for (const cv::Point& p : hidden) {
+    lines.disparity(p) = 0.f;
+    if (has_ring_map) lines.ring(p) = -1;
+  }
+  index.erase(hidden);
+  std::vector<cv::Point> merged;
+  merged.reserve(removed.size() + hidden.size());
+  std::merge(removed.begin(), removed.end(), hidden.begin(), hidden.end(),
+             std::back_inserter(merged), [](const cv::Point& a, const cv::Point& b) {
+               return a.x < b.x || (a.x == b.x && a.y < b.y);
+             });
+  removed.swap(merged);
+}
+
+int removeParallaxHidden(ScanLines& lines, const StereoCamera& camera,
+                         const Eigen::Vector3d& lidar_origin, const BIParams& params,
+                         std::vector<cv::Point>* removed_pixels) {
+  params.validate();
+  requireDisparityMap(lines.disparity, "removeParallaxHidden");
+  ColumnIndex index(lines.disparity);
+  std::vector<cv::Point> removed;
+  removeParallaxHiddenIndexed(lines, index, camera, lidar_origin, params, removed);
+  const int count = static_cast<int>(removed.size());
+  if (removed_pixels) *removed_pixels = std::move(removed);
+  return count;
 }
 
 cv::Mat1f interpolateBetweenScanLines(const ScanLines& lines, const BIParams& params) {

@@ -43,8 +43,8 @@ cv::Mat1f syntheticLidarReference(const sim::Scene& scene, const sim::SyntheticP
       const int u = static_cast<int>(std::floor(camera.fx * c.x() / c.z() + camera.cx + 0.5));
       if (v < 0 || v >= reference.rows) continue;
       const float z = static_cast<float>(c.z());
-      for (int x = std::max(0, u - footprint_px); x <= std::min(reference.cols - 1, u + footprint_px);
-           ++x) {
+      for (int x = std::max(0, u - footprint_px);
+           x <= std::min(reference.cols - 1, u + footprint_px); ++x) {
         float& r = reference(v, x);
         if (r == 0.f || z < r) r = z;
       }
@@ -96,12 +96,10 @@ std::vector<LayoutScores<DepthMetrics>> runSyntheticDenseProtocol(
     PmsRun pms;
     scoreDepthCaseAgainst({frame, frame.cloud, exact, calib}, targets, options, rows, pms);
   }
-  const std::string what = "the synthetic street (seeds " + std::to_string(params.seeds.front()) +
-                           (params.seeds.size() > 1
-                                ? "-" + std::to_string(params.seeds.back())
-                                : std::string()) +
-                           "), frame " + std::to_string(params.frame) +
-                           ", the full 64-ring sweep fed, scored against ";
+  const std::string what =
+      "the synthetic street (seeds " + std::to_string(params.seeds.front()) +
+      (params.seeds.size() > 1 ? "-" + std::to_string(params.seeds.back()) : std::string()) +
+      "), frame " + std::to_string(params.frame) + ", the full 64-ring sweep fed, scored against ";
   for (size_t i = 0; i < out.size(); ++i) {
     out[i].methods = acc[i].finish();
     out[i].description =

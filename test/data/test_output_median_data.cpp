@@ -1,5 +1,6 @@
 // The output median keeps the LiDAR's points on the real KITTI drive 0009 (core/output_median.h):
-// wherever the output without a median agrees with a measured point (within edge_tolerance), the
+// wherever the output without a median agrees with a measured point (one that BI*'s Algorithm 1
+// and step 2b leave on the scan lines; within edge_tolerance), the
 // output with the median has that very value; a plain 3x3 median of the same output would move
 // more than 50 of them by over 1 px (on frame 20: one-pixel columns of poles and edges, 114 of
 // them more than 3 m). Frames 0 and 20, both presets, the full sweep in.
@@ -35,7 +36,8 @@ void expectMeasuredPointsKept(FusionParams params, const std::string& preset) {
     const FusionResult kept = with_median.process(input);
     const FusionResult raw = no_median.process(input);
     ScanLines lines = completeScanLines(raw.sparse, params.bi);
-    removeOccludedPoints(lines, data.left, params.bi);
+    removeOccludedPoints(lines, data.left, params.bi);  // stage 2's steps 2 and 2b, as the pipeline
+    removeParallaxHidden(lines, calib.camera, calib.T_cam_velo.translation(), params.bi);
     const cv::Mat1f measured = measuredPoints(raw.sparse.disparity, lines.disparity);
     const cv::Mat1f plain = medianOfValues(raw.disparity, 3);
     int confirmed = 0, moved = 0, moved_by_plain = 0;

@@ -57,6 +57,14 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, BIParams>> visitParams(P&& p, V
               "Scan lines Algorithm 1 looks at up and down "
               "(paper: 1)"},
     p.search_lines);
+  v(ParamSpec{"remove_parallax_hidden",
+              g,
+              {},
+              "",
+              "Fused methods: after Algorithm 1, clear a scan-line pixel that the nearer scan "
+              "line next to it in its column more likely than not hides from the camera, for the "
+              "images to decide (a LiDAR above the camera sees over top edges; false: the paper)"},
+    p.remove_parallax_hidden);
   v(ParamSpec{"max_interp_rows", g, atLeast(1), "rows",
               "Eq. 3 does not bridge scan lines further apart"},
     p.max_interp_rows);

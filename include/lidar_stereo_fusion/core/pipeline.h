@@ -1,6 +1,8 @@
 // The whole method: projection -> up-sampling -> guided PatchMatch -> depth. ROS-free.
 #pragma once
 
+#include <optional>
+
 #include <string>
 
 #include <Eigen/Geometry>
@@ -88,15 +90,19 @@ class FusionPipeline {
   /// Stages 2-4 from sparse disparities already projected into both views (a pseudo-LiDAR made
   /// from ground truth, or a caller that projects itself). `right_sparse` is used by the fused
   /// methods only (may be empty otherwise). The camera gives the depth conversion; pass any valid
-  /// camera of the image size when only the disparity is wanted. Same errors as process().
+  /// camera of the image size when only the disparity is wanted. The LiDAR's pose is unknown
+  /// here, so BI* skips removeParallaxHidden. Same errors as process().
   FusionResult processSparse(const cv::Mat& left, const cv::Mat& right,
                              const SparseDisparity& left_sparse,
                              const SparseDisparity& right_sparse, const StereoCamera& camera);
 
  private:
+  /// `lidar_origin`: the LiDAR's origin in the left camera's frame [m] (nullopt: unknown, then
+  /// no removeParallaxHidden).
   FusionResult runStages(const cv::Mat& left, const cv::Mat& right,
                          const SparseDisparity& left_sparse, const SparseDisparity& right_sparse,
-                         const StereoCamera& camera);
+                         const StereoCamera& camera,
+                         const std::optional<Eigen::Vector3d>& lidar_origin);
 
   FusionParams params_;
   PatchMatchStereo patchmatch_;

@@ -20,7 +20,11 @@ struct BIParams {
   bool step_fill = true;
   double max_disp_diff = 1.5;    ///< Algorithm 1 "Maxdisp": foreground must exceed d by this [px]
   double max_color_diff = 60.0;  ///< Algorithm 1 "Maxcolor": RGB L1 distance [0..765]
-  int search_lines = 2;      ///< Algorithm 1 looks at this many scan lines up and down (paper: 1)
+  int search_lines = 2;  ///< Algorithm 1 looks at this many scan lines up and down (paper: 1)
+  /// After Algorithm 1, clear a scan-line pixel that the nearer scan line next to it in its column
+  /// more likely than not hides from the camera, for the images to decide (removeParallaxHidden;
+  /// the fused methods, with the LiDAR's pose: FusionPipeline::process). false: the paper.
+  bool remove_parallax_hidden = true;
   int max_interp_rows = 60;  ///< Eq. 3 does not bridge scan lines further apart than this [rows]
   void validate() const;
 };
@@ -63,6 +67,25 @@ ScanLines completeScanLines(const SparseDisparity& sparse, const BIParams& param
 /// number removed; `removed_pixels` (optional) receives them (x = column, y = row). Throws
 /// std::invalid_argument for an image of another size or type.
 int removeOccludedPoints(ScanLines& lines, const cv::Mat& image, const BIParams& params,
+                         std::vector<cv::Point>* removed_pixels = nullptr);
+
+/// BI* step 2b (not in the paper), after Algorithm 1: the LiDAR sits off the camera (KITTI's 8 cm
+/// above and 27 cm behind it), so past a near object's edge it sees background that the object
+/// hides from the camera, and that background lands in the image on the object's side of the edge
+/// (above the camera, under top edges). Algorithm 1 clears such a pixel only with a similar
+/// foreground above and below it. Here, for each two consecutive scan-line pixels p and q of a
+/// column where q is nearer by more than max_disp_diff: the edge of q's surface lies, as far as
+/// the LiDAR can tell, anywhere between q and the LiDAR's ray to p; carried to q's depth that ray
+/// lands in the image a shift s from p's row (towards q's side when it can hide p). p is cleared
+/// when s >= the rows from p to q: the edge then hides p at least as likely as not (an edge
+/// anywhere in that range, evenly). `lidar_origin` is the LiDAR's origin in this view's camera
+/// frame [m] (x right, y down, z forward); `camera` gives fx, fy, cx, cy and fx * baseline for
+/// the depths. Returns the number cleared; `removed_pixels` (optional) receives them ordered by
+/// column, then row. Cleared pixels get disparity 0 and ring -1. Does nothing when
+/// params.remove_parallax_hidden is false. Throws std::invalid_argument for an invalid camera or
+/// a non-finite origin.
+int removeParallaxHidden(ScanLines& lines, const StereoCamera& camera,
+                         const Eigen::Vector3d& lidar_origin, const BIParams& params,
                          std::vector<cv::Point>* removed_pixels = nullptr);
 
 /// BI* step 3 (Eq. 3): linear interpolation in every column between the nearest scan lines above
