@@ -85,12 +85,12 @@ std::vector<LayoutScores<DepthMetrics>> runSyntheticDenseProtocol(
     kitti::Calibration calib;
     calib.camera = f.camera;
     calib.T_cam_velo = f.T_cam_lidar;
+    std::set<int> rings;
+    for (const LidarPoint& p : f.cloud) rings.insert(p.ring);
     std::vector<DepthTarget> targets;
     for (size_t i = 0; i < out.size(); ++i) {
       targets.push_back({out[i].name == "syn_exact" ? exact : lidar_made, acc[i]});
       out[i].items.push_back("seed " + std::to_string(seed));
-      std::set<int> rings;
-      for (const LidarPoint& p : f.cloud) rings.insert(p.ring);
       out[i].fed_rings.push_back(static_cast<int>(rings.size()));
     }
     PmsRun pms;

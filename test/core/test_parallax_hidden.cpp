@@ -1,8 +1,9 @@
-// Stage 2, BI* step 2b: scan-line pixels the camera cannot see past a nearer line, by the LiDAR-camera
-// offset (removeParallaxHidden). Exact answers on hand-made columns: camera fx = fy = 100 px, cx =
-// cy = 50 px, baseline 0.5 m (z = 50 / d). With the LiDAR origin o = (0, oy, 0), the LiDAR's ray to
-// a pixel p at row v_p lands, at the depth of a line q, on row v_p + 100 oy (1 / z_q - 1 / z_p) =
-// v_p + 2 oy (d_q - d_p): with oy = -0.1 (10 cm above the camera) 0.2 (d_q - d_p) rows above p.
+// Stage 2, BI* step 2b: scan-line pixels the camera cannot see past a nearer line, by the
+// LiDAR-camera offset (removeParallaxHidden). Exact answers on hand-made columns: camera fx = fy =
+// 100 px, cx = cy = 50 px, baseline 0.5 m (z = 50 / d). With the LiDAR origin o = (0, oy, 0), the
+// LiDAR's ray to a pixel p at row v_p lands, at the depth of a line q, on row v_p + 100 oy (1 / z_q
+// - 1 / z_p) = v_p + 2 oy (d_q - d_p): with oy = -0.1 (10 cm above the camera) 0.2 (d_q - d_p) rows
+// above p.
 #include <limits>
 #include <stdexcept>
 #include <vector>

@@ -8,22 +8,17 @@
 
 #include "lidar_stereo_fusion/eval/synthetic_dense.h"
 #include "lidar_stereo_fusion/sim/scene.h"
+#include "sim/small_sim_params.h"
 
 namespace lsf = lidar_stereo_fusion;
 namespace sim = lidar_stereo_fusion::sim;
 
 namespace {
 
-/// A small camera and a light sweep; the rig stands still unless a test moves it.
+/// The small camera of the sim tests with a denser sweep; the rig stands still unless a test
+/// moves it.
 sim::SyntheticParams smallParams() {
-  sim::SyntheticParams p;
-  p.width = 160;
-  p.height = 120;
-  p.fx = p.fy = 100.0;
-  p.cx = 79.5;
-  p.cy = 59.5;
-  p.subsamples = 1;
-  p.image_noise_sigma = 0.0;
+  sim::SyntheticParams p = lsf::test::smallSyntheticParams();
   p.azimuth_step_deg = 0.2;
   p.speed = 0.0;
   return p;

@@ -18,26 +18,14 @@
 #include "lidar_stereo_fusion/sim/kitti_export.h"
 #include "lidar_stereo_fusion/sim/scene.h"
 #include "lidar_stereo_fusion/sim/synthetic_frame.h"
+#include "sim/small_sim_params.h"
 
 namespace lsf = lidar_stereo_fusion;
 namespace sim = lidar_stereo_fusion::sim;
 
 namespace {
 
-/// A small camera with pixel centres off the horizon row, exact and noise-free images.
-sim::SyntheticParams smallParams() {
-  sim::SyntheticParams p;
-  p.width = 160;
-  p.height = 120;
-  p.fx = p.fy = 100.0;
-  p.cx = 79.5;
-  p.cy = 59.5;
-  p.baseline = 0.5;
-  p.subsamples = 1;
-  p.image_noise_sigma = 0.0;
-  p.azimuth_step_deg = 0.5;  // a lighter sweep: the geometry checks need no density
-  return p;
-}
+sim::SyntheticParams smallParams() { return lsf::test::smallSyntheticParams(); }
 
 int addTexturedMaterial(sim::Scene& scene) {
   sim::Material m;
