@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "lidar_stereo_fusion/eval/accuracy_dense.h"
 #include "lidar_stereo_fusion/eval/accuracy_protocols.h"
@@ -197,14 +198,21 @@ void printMiddlebury(const lsf::AccuracyOptions& options) {
   std::cout << "Middlebury protocol: " << secondsSince(t) << " s\n\n";
 }
 
-void printKitti(const lsf::AccuracyOptions& options) {
-  const auto t = std::chrono::steady_clock::now();
-  for (const auto& layout : lsf::runKittiProtocol(options)) {
+/// A depth protocol's layouts: the method table, the depth bands and the regions, each the mean
+/// over the layout's `items` (frames, seeds).
+void printDepthLayouts(const std::vector<lsf::LayoutScores<lsf::DepthMetrics>>& layouts,
+                       const std::string& items) {
+  for (const auto& layout : layouts) {
     std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
-              << lsf::formatKittiLayout(layout) << "\nPer depth band (mean of frames):\n\n"
-              << lsf::formatDepthBands(layout) << "\nPer region (mean of frames):\n\n"
+              << lsf::formatKittiLayout(layout) << "\nPer depth band (mean of " << items << "):\n\n"
+              << lsf::formatDepthBands(layout) << "\nPer region (mean of " << items << "):\n\n"
               << lsf::formatKittiRegions(layout) << "\n";
   }
+}
+
+void printKitti(const lsf::AccuracyOptions& options) {
+  const auto t = std::chrono::steady_clock::now();
+  printDepthLayouts(lsf::runKittiProtocol(options), "frames");
   std::cout << "KITTI protocol: " << secondsSince(t) << " s"
             << (options.kitti_pms ? "" : " (without pms)") << "\n\n";
 }
@@ -231,12 +239,7 @@ void printDense(const lsf::AccuracyOptions& options, const Options& o) {
 
 void printSynthetic(const lsf::AccuracyOptions& options) {
   const auto t = std::chrono::steady_clock::now();
-  for (const auto& layout : lsf::runSyntheticDenseProtocol(options)) {
-    std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
-              << lsf::formatKittiLayout(layout) << "\nPer depth band (mean of seeds):\n\n"
-              << lsf::formatDepthBands(layout) << "\nPer region (mean of seeds):\n\n"
-              << lsf::formatKittiRegions(layout) << "\n";
-  }
+  printDepthLayouts(lsf::runSyntheticDenseProtocol(options), "seeds");
   std::cout << "Synthetic dense protocol: " << secondsSince(t) << " s"
             << (options.kitti_pms ? "" : " (without pms)") << "\n";
 }

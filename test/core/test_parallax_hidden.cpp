@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "lidar_stereo_fusion/core/upsampling.h"
+#include "test_scenes.h"
 #include "upsampling_test_util.h"
 
 namespace lidar_stereo_fusion {
@@ -18,14 +19,7 @@ namespace {
 
 using namespace test;  // NOLINT: the maps of upsampling_test_util.h
 
-StereoCamera camera100() {
-  StereoCamera c;
-  c.fx = c.fy = 100.0;
-  c.cx = c.cy = 50.0;
-  c.baseline = 0.5;
-  c.width = c.height = 100;
-  return c;
-}
+StereoCamera camera100() { return centredCamera(100, 100, 100.0); }
 
 /// Writes a scan-line pixel.
 void put(ScanLines& l, int x, int y, float d, short ring) {
