@@ -15,6 +15,7 @@
 #include "lidar_stereo_fusion/eval/accuracy_dense.h"
 #include "lidar_stereo_fusion/eval/accuracy_protocols.h"
 #include "lidar_stereo_fusion/eval/accuracy_tables.h"
+#include "lidar_stereo_fusion/eval/sweep_order.h"
 #include "lidar_stereo_fusion/eval/synthetic_dense.h"
 #include "lidar_stereo_fusion/io/cli.h"
 #include "lidar_stereo_fusion/io/params_yaml.h"
@@ -69,11 +70,17 @@ Options:
   --keep-unverified     dense: keep other sweeps' points where frame 20's own sweep has none
                         nearby (above its top beam, its dropouts), as KITTI's ground truth does;
                         with --stereo-check 3 the reference most like KITTI's
+  --sweep-order <o>     kitti and dense: the fed sweep recorded (default: rings from the sweep
+                        order), or with its order lost and its rings recovered as the node does
+                        for a cloud without a ring field: shuffled, image-rows, or
+                        image-rows-cropped (only the points in view, as a depth-completion
+                        dataset gives them); the references are unchanged
   --help                this text
 )";
 
 struct Options {
-  std::string data, params, ip_basic_blur = "gaussian", reference = "nearest";
+  std::string data, params, ip_basic_blur = "gaussian", reference = "nearest",
+                            sweep_order = "recorded";
   double stereo_check_px = 0.0;
   std::set<std::string> methods, layouts;
   bool middlebury = true, kitti = true, dense = true, synthetic = true, kitti_pms = true;
@@ -104,10 +111,11 @@ std::string defaultDataDir() {
 }
 
 Options parseOptions(int argc, char** argv) {
-  const lsf::CommandLine cl(argc, argv,
-                            {"--data", "--protocols", "--layouts", "--frames", "--params",
-                             "--methods", "--ip-basic-blur", "--reference", "--stereo-check"},
-                            {"--no-kitti-pms", "--keep-unverified"});
+  const lsf::CommandLine cl(
+      argc, argv,
+      {"--data", "--protocols", "--layouts", "--frames", "--params", "--methods", "--ip-basic-blur",
+       "--reference", "--stereo-check", "--sweep-order"},
+      {"--no-kitti-pms", "--keep-unverified"});
   Options o;
   o.data = cl.value("--data", defaultDataDir());
   o.frames = cl.intValue("--frames", 0, 1, 1000);
@@ -116,6 +124,7 @@ Options parseOptions(int argc, char** argv) {
   o.params = cl.value("--params", "");
   o.ip_basic_blur = cl.choice("--ip-basic-blur", "gaussian", {"gaussian", "bilateral", "none"});
   o.reference = cl.choice("--reference", "nearest", {"nearest", "majority"});
+  o.sweep_order = cl.choice("--sweep-order", "recorded", lsf::sweepOrderNames());
   o.stereo_check_px = cl.doubleValue("--stereo-check", 0.0, 0.0, 1000.0);
   if (cl.has("--methods")) o.methods = splitList(cl.value("--methods"));
   if (cl.has("--layouts")) o.layouts = splitList(cl.value("--layouts"));
@@ -168,6 +177,7 @@ lsf::AccuracyOptions accuracyOptions(const Options& o) {
   options.data_dir = o.data;
   options.kitti_frames = o.frames;
   options.kitti_pms = o.kitti_pms;
+  options.sweep_order = lsf::parseSweepOrder(o.sweep_order);
   options.progress = &std::cerr;
   options.methods = o.methods;
   options.layouts = o.layouts;

@@ -2,6 +2,7 @@
 #include "accuracy_common.h"
 
 #include <cmath>
+#include <set>
 
 #include "lidar_stereo_fusion/core/depth.h"
 
@@ -142,6 +143,22 @@ void scoreDepthCaseAgainst(const DepthCase& c, const std::vector<DepthTarget>& t
                      rawCoverage(run.first, target.reference), run.second);
     }
   }
+}
+
+FedSweep fedSweep(const LidarCloud& cloud, const AccuracyOptions& options,
+                  const kitti::Calibration& calib) {
+  FedSweep out;
+  ReorderedSweep sweep =
+      reorderSweep(cloud, options.sweep_order, calib.T_cam_velo, calib.camera, 64, 7);
+  out.cloud = std::move(sweep.cloud);
+  std::set<int> rings;
+  for (const LidarPoint& p : out.cloud) rings.insert(p.ring);
+  out.rings = static_cast<int>(rings.size());
+  if (options.sweep_order != SweepOrder::kRecorded) {
+    out.note = ", the sweep's order lost (" + sweepOrderName(options.sweep_order) +
+               ", its rings recovered by " + ringSourceName(sweep.rings.source) + ")";
+  }
+  return out;
 }
 
 }  // namespace accuracy_detail

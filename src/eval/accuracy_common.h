@@ -80,6 +80,17 @@ class LayoutAccumulator {
   std::map<std::string, MethodScores<Metrics>> rows_;
 };
 
+/// A KITTI sweep as the protocols feed it (options.sweep_order; eval/sweep_order.h).
+struct FedSweep {
+  LidarCloud cloud;
+  int rings = 0;     ///< distinct rings of the fed cloud (recovered ones with the order lost)
+  std::string note;  ///< for the layout's description: "" as recorded, else how it was fed
+};
+/// `cloud` (rings from the sweep order) in options.sweep_order, rings recovered for KITTI's
+/// HDL-64E (num_rings 64, the node's default); kShuffled with seed 7.
+FedSweep fedSweep(const LidarCloud& cloud, const AccuracyOptions& options,
+                  const kitti::Calibration& calib);
+
 /// One KITTI case: a frame's images, the cloud fed to every method, the reference depth.
 struct DepthCase {
   const kitti::FrameData& frame;

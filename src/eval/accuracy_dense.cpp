@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <filesystem>
 #include <ostream>
-#include <set>
 #include <stdexcept>
 
 #include "accuracy_common.h"
@@ -45,19 +44,17 @@ DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
   LayoutScores<DepthMetrics>& layout = out.layout;
   layout.name = "dense";
   layout.items.push_back(frame->name);
-  std::set<int> rings;
-  for (const LidarPoint& p : data.cloud) rings.insert(p.ring);
-  layout.fed_rings.push_back(static_cast<int>(rings.size()));
+  const FedSweep fed = fedSweep(data.cloud, options, calib);
+  layout.fed_rings.push_back(fed.rings);
   LayoutAccumulator<DepthMetrics> acc;
   PmsRun pms;
-  scoreDepthCase({data, data.cloud, out.reference.depth, calib}, options,
+  scoreDepthCase({data, fed.cloud, out.reference.depth, calib}, options,
                  pipelineRows(options, options.kitti_pms), pms, acc);
   layout.methods = acc.finish();
   const long center = static_cast<long>(kitti::frameIndex(kDenseFrame));
   layout.description =
       "KITTI drive 0009 frame " + std::to_string(center) + ", the full sweep (" +
-      std::to_string(rings.size()) +
-      " rings) fed, scored against the depth accumulated from sweeps " +
+      std::to_string(fed.rings) + " rings) fed, scored against the depth accumulated from sweeps " +
       std::to_string(center - reference_params.half_span) + "-" +
       std::to_string(center + reference_params.half_span) + " (" +
       std::to_string(out.reference.pixels) + " pixels, the frame's own sweep included; " +
@@ -67,7 +64,8 @@ DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
       (reference_params.keep_unverified ? ", points with no own point nearby kept" : "") +
       (stereo_check_px > 0.0
            ? ", kept where SGBM agrees within " + format("%g", stereo_check_px) + " px"
-           : std::string());
+           : std::string()) +
+      fed.note;
   return out;
 }
 

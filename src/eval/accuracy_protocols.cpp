@@ -218,6 +218,7 @@ std::vector<LayoutScores<DepthMetrics>> runKittiProtocol(const AccuracyOptions& 
   }
   const auto rows = pipelineRows(options, options.kitti_pms);
   std::vector<LayoutAccumulator<DepthMetrics>> acc(out.size());
+  std::vector<std::string> notes(out.size());
   for (const kitti::Frame& frame : frames) {
     if (options.progress) *options.progress << "KITTI frame " << frame.name << std::endl;
     const kitti::FrameData data = kitti::loadFrame(frame, calib.camera);
@@ -227,10 +228,10 @@ std::vector<LayoutScores<DepthMetrics>> runKittiProtocol(const AccuracyOptions& 
           makeRingHoldout(data.cloud, calib.T_cam_velo, calib.camera, options.fused.projection,
                           kittiKeepEvery(out[li].name));
       out[li].items.push_back(frame.name);
-      std::set<int> rings;
-      for (const LidarPoint& p : holdout.fed) rings.insert(p.ring);
-      out[li].fed_rings.push_back(static_cast<int>(rings.size()));
-      scoreDepthCase({data, holdout.fed, holdout.reference_depth, calib}, options, rows, pms,
+      FedSweep fed = fedSweep(holdout.fed, options, calib);
+      out[li].fed_rings.push_back(fed.rings);
+      if (!fed.note.empty()) notes[li] = fed.note;
+      scoreDepthCase({data, fed.cloud, holdout.reference_depth, calib}, options, rows, pms,
                      acc[li]);
     }
   }
@@ -240,7 +241,7 @@ std::vector<LayoutScores<DepthMetrics>> runKittiProtocol(const AccuracyOptions& 
     out[li].description = "KITTI drive 0009 ring hold-out, " + std::to_string(n) +
                           " rings fed (ring % " + std::to_string(kittiKeepEvery(out[li].name)) +
                           " == 0), the other rings scored, " + std::to_string(frames.size()) +
-                          " frames";
+                          " frames" + notes[li];
   }
   return out;
 }

@@ -4,16 +4,13 @@
 #pragma once
 
 #include <algorithm>
-#include <cmath>
 #include <cstddef>
 #include <map>
-#include <numeric>
-#include <random>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "lidar_stereo_fusion/core/types.h"
+#include "lidar_stereo_fusion/eval/sweep_order.h"
 #include "lidar_stereo_fusion/io/kitti.h"
 
 namespace lidar_stereo_fusion {
@@ -39,41 +36,24 @@ inline RingVariant makeVariant(const LidarCloud& base, const std::vector<std::si
 }
 
 /// Indices of the points of rings with ring % keep_every == 0 (all for keep_every 1), shuffled
-/// with `seed`.
+/// with `seed` (shuffledIndices: the same swaps as std::shuffle of the list itself).
 inline std::vector<std::size_t> shuffledOrder(const LidarCloud& base, unsigned seed,
                                               int keep_every = 1) {
-  std::vector<std::size_t> order;
+  std::vector<std::size_t> kept;
   for (std::size_t i = 0; i < base.size(); ++i) {
-    if (base[i].ring % keep_every == 0) order.push_back(i);
+    if (base[i].ring % keep_every == 0) kept.push_back(i);
   }
-  std::mt19937 rng(seed);
-  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<std::size_t> order;
+  order.reserve(kept.size());
+  for (const std::size_t k : shuffledIndices(kept.size(), seed)) order.push_back(kept[k]);
   return order;
 }
 
-/// Image-row order: the points that land in the left image (rounded as projectCloud does, depth
-/// >= 0.5 m) sorted by row, then column, then storage order; then, unless `crop`, every other
-/// point in storage order. `crop` is what a depth-completion dataset gives: only points in view.
+/// Image-row order (imageRowIndices); `crop` is what a depth-completion dataset gives: only the
+/// points in view.
 inline std::vector<std::size_t> imageRowOrder(const LidarCloud& base,
                                               const kitti::Calibration& calib, bool crop) {
-  std::vector<std::tuple<int, int, std::size_t>> in_view;
-  std::vector<std::size_t> outside;
-  const StereoCamera& c = calib.camera;
-  for (std::size_t i = 0; i < base.size(); ++i) {
-    const Eigen::Vector3d p = calib.T_cam_velo * Eigen::Vector3d(base[i].x, base[i].y, base[i].z);
-    const double col = std::floor(c.fx * p.x() / p.z() + c.cx + 0.5);
-    const double row = std::floor(c.fy * p.y() / p.z() + c.cy + 0.5);
-    if (p.z() >= 0.5 && col >= 0 && col < c.width && row >= 0 && row < c.height) {
-      in_view.emplace_back(static_cast<int>(row), static_cast<int>(col), i);
-    } else {
-      outside.push_back(i);
-    }
-  }
-  std::sort(in_view.begin(), in_view.end());
-  std::vector<std::size_t> order;
-  for (const auto& entry : in_view) order.push_back(std::get<2>(entry));
-  if (!crop) order.insert(order.end(), outside.begin(), outside.end());
-  return order;
+  return imageRowIndices(base, calib.T_cam_velo, calib.camera, crop);
 }
 
 /// Agreement of recovered rings with the truth after the one relabelling: each recovered ring is

@@ -55,7 +55,9 @@ TEST(SyntheticLidarReference, APlaneFacingTheCameraGivesItsDepthWhereReturnsLand
   EXPECT_LT(hit, ref.total() / 2);  // points, not a surface
   for (int v = 0; v < ref.rows; ++v) {
     for (int u = 0; u < ref.cols; ++u) {
-      if (ref(v, u) > 0.f) ASSERT_NEAR(ref(v, u), kWallZ, 1e-4) << u << ", " << v;
+      if (ref(v, u) > 0.f) {
+        ASSERT_NEAR(ref(v, u), kWallZ, 1e-4) << u << ", " << v;
+      }
     }
   }
 }
@@ -78,7 +80,9 @@ TEST(SyntheticLidarReference, TheFootprintWidensEveryReturnByItsColumnsNearestWi
   EXPECT_GT(cv::countNonZero(foreground), cv::countNonZero(below(points, 15.0)));
   for (int v = 0; v < wide.rows; ++v) {
     for (int u = 0; u < wide.cols; ++u) {
-      if (foreground(v, u)) ASSERT_NEAR(wide(v, u), kBoxZ, 1e-4) << u << ", " << v;
+      if (foreground(v, u)) {
+        ASSERT_NEAR(wide(v, u), kBoxZ, 1e-4) << u << ", " << v;
+      }
     }
   }
 }
@@ -98,7 +102,9 @@ TEST(SyntheticLidarReference, MoreSweepsAddReturnsAndANearerReturnWins) {
   EXPECT_GT(cv::countNonZero(five > 0.f), cv::countNonZero(one > 0.f));
   for (int v = 0; v < one.rows; ++v) {
     for (int u = 0; u < one.cols; ++u) {
-      if (one(v, u) > 0.f) ASSERT_LE(five(v, u), one(v, u)) << u << ", " << v;
+      if (one(v, u) > 0.f) {
+        ASSERT_LE(five(v, u), one(v, u)) << u << ", " << v;
+      }
     }
   }
 }

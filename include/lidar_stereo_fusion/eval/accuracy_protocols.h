@@ -57,6 +57,7 @@
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/metrics.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/eval/sweep_order.h"
 
 namespace lidar_stereo_fusion {
 
@@ -159,6 +160,10 @@ struct AccuracyOptions {
   std::set<std::string> layouts;  ///< layout names to run; empty = all
   int kitti_frames = 0;           ///< the first N frames; 0 = all
   bool kitti_pms = true;  ///< false: skip pms and "lidar_bi else pms" on KITTI (ring and dense)
+  /// KITTI (ring hold-out and dense): the fed sweep as recorded, or with its order lost and its
+  /// rings recovered as the node does (eval/sweep_order.h; the hold-out still splits by the
+  /// recorded rings, and the reference is unchanged).
+  SweepOrder sweep_order = SweepOrder::kRecorded;
   std::ostream* progress = nullptr;  ///< one line per scene / frame when set
   /// Throws std::invalid_argument for an unknown method / layout name or kitti_frames < 0.
   void validate() const;
