@@ -228,7 +228,7 @@ std::vector<LayoutScores<DepthMetrics>> runKittiProtocol(const AccuracyOptions& 
           makeRingHoldout(data.cloud, calib.T_cam_velo, calib.camera, options.fused.projection,
                           kittiKeepEvery(out[li].name));
       out[li].items.push_back(frame.name);
-      FedSweep fed = fedSweep(holdout.fed, options, calib);
+      const FedSweep fed = fedSweep(holdout.fed, options, calib);
       out[li].fed_rings.push_back(fed.rings);
       if (!fed.note.empty()) notes[li] = fed.note;
       scoreDepthCase({data, fed.cloud, holdout.reference_depth, calib}, options, rows, pms,

@@ -48,8 +48,8 @@ struct ReorderedSweep {
 
 /// `cloud` in `order` (kShuffled with `seed`), every ring set to -1 and then recovered by
 /// ensureRings(cloud, false, num_rings), as the node does for a cloud without a ring field.
-/// kRecorded returns the cloud unchanged. Throws std::invalid_argument for num_rings < 1 or an
-/// invalid camera.
+/// kRecorded returns the cloud unchanged. Throws std::invalid_argument for num_rings < 1, and for
+/// an invalid camera with the image-row orders.
 ReorderedSweep reorderSweep(const LidarCloud& cloud, SweepOrder order,
                             const Eigen::Isometry3d& T_cam_lidar, const StereoCamera& camera,
                             int num_rings, unsigned seed);
