@@ -58,16 +58,16 @@ TEST(SweepOrder, ImageRowsSortByRowThenColumnThenStorageWithTheRestAfterOrDroppe
   const StereoCamera camera = test::centredCamera(200, 100, 100.0);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   LidarCloud cloud = {
-      at(0, 0, 10),                // 0: row 50, column 100
-      at(-5, -2.5, 10),            // 1: row 25, column 50
-      at(0, 0, 0.3),               // 2: nearer than 0.5 m: outside
-      at(5, 2.5, 10),              // 3: row 75, column 150
-      at(-1, -0.5, 10),            // 4: row 45, column 90
-      at(nan, 0, 10),              // 5: not finite: outside
-      at(30, 0, 10),               // 6: column 400: outside
-      at(-5, -2.5, 10),            // 7: the pixel of 1: after it
-      at(-4.96, -2.5, 10),         // 8: column 50.4 rounds to 50, the pixel of 1 and 7
-      at(-5.96, -2.5, 10),         // 9: column 40.4 -> 40: first in row 25
+      at(0, 0, 10),         // 0: row 50, column 100
+      at(-5, -2.5, 10),     // 1: row 25, column 50
+      at(0, 0, 0.3),        // 2: nearer than 0.5 m: outside
+      at(5, 2.5, 10),       // 3: row 75, column 150
+      at(-1, -0.5, 10),     // 4: row 45, column 90
+      at(nan, 0, 10),       // 5: not finite: outside
+      at(30, 0, 10),        // 6: column 400: outside
+      at(-5, -2.5, 10),     // 7: the pixel of 1: after it
+      at(-4.96, -2.5, 10),  // 8: column 50.4 rounds to 50, the pixel of 1 and 7
+      at(-5.96, -2.5, 10),  // 9: column 40.4 -> 40: first in row 25
   };
   const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
   EXPECT_EQ(imageRowIndices(cloud, identity, camera, false),
