@@ -164,6 +164,19 @@ Options parseOptions(int argc, char** argv) {
         "--protocols and --layouts leave nothing to run (no chosen layout "
         "belongs to a chosen protocol)");
   }
+  // An option for a protocol that does not run would change nothing: say so, not ignore it.
+  for (const char* option : {"--reference", "--stereo-check", "--keep-unverified"}) {
+    if (cl.has(option) && !o.dense) {
+      throw lsf::UsageError(std::string(option) +
+                            " applies to the dense protocol, which --protocols and --layouts "
+                            "leave out");
+    }
+  }
+  if (cl.has("--sweep-order") && !o.kitti && !o.dense) {
+    throw lsf::UsageError(
+        "--sweep-order applies to the kitti and dense protocols, which --protocols and "
+        "--layouts leave out");
+  }
   return o;
 }
 

@@ -1,0 +1,55 @@
+// accuracy_report's command line: an option for a protocol that does not run is refused with a
+// message naming it (exit 2, before any data is read), never ignored.
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "tools/tool_runner.h"
+
+namespace lsf = lidar_stereo_fusion;
+
+namespace {
+
+/// Runs accuracy_report with `args` in a scratch folder (its output captured there).
+lsf::test::RunResult accuracyReport(const std::string& args) {
+  namespace fs = std::filesystem;
+  const std::string path = lsf::test::toolPath("accuracy_report");
+  EXPECT_FALSE(path.empty()) << "accuracy_report is not built next to " << LSF_BINARY_DIR;
+  const fs::path scratch =
+      fs::temp_directory_path() / ("lsf_accuracy_report_" + std::to_string(::getpid()));
+  fs::create_directories(scratch);
+  const lsf::test::RunResult r =
+      lsf::test::runCommand(path + " --data /nonexistent " + args, scratch);
+  fs::remove_all(scratch);
+  return r;
+}
+
+TEST(AccuracyReportOptions, AnOptionForAProtocolThatDoesNotRunIsRefused) {
+  const struct {
+    const char* args;
+    const char* named;
+  } cases[] = {
+      {"--protocols middlebury --sweep-order shuffled", "--sweep-order applies to the kitti"},
+      {"--protocols synthetic --stereo-check 3", "--stereo-check applies to the dense"},
+      {"--protocols kitti --keep-unverified", "--keep-unverified applies to the dense"},
+      {"--layouts ring32 --reference majority", "--reference applies to the dense"},
+  };
+  for (const auto& c : cases) {
+    const lsf::test::RunResult r = accuracyReport(c.args);
+    EXPECT_EQ(r.status, 2) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.named), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_EQ(r.out, "") << c.args;
+  }
+}
+
+TEST(AccuracyReportOptions, AnUnknownSweepOrderIsNamedWithTheValidOnes) {
+  const lsf::test::RunResult r = accuracyReport("--protocols dense --sweep-order sorted");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("'sorted'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("image-rows-cropped"), std::string::npos) << r.err;
+}
+
+}  // namespace
