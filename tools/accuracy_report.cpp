@@ -164,7 +164,7 @@ Options parseOptions(int argc, char** argv) {
         "--protocols and --layouts leave nothing to run (no chosen layout "
         "belongs to a chosen protocol)");
   }
-  // An option for a protocol that does not run would change nothing: say so, not ignore it.
+  // An option that only a protocol left out would read changes nothing: say so, not ignore it.
   for (const char* option : {"--reference", "--stereo-check", "--keep-unverified"}) {
     if (cl.has(option) && !o.dense) {
       throw lsf::UsageError(std::string(option) +
@@ -177,6 +177,11 @@ Options parseOptions(int argc, char** argv) {
         "--sweep-order applies to the kitti and dense protocols, which --protocols and "
         "--layouts leave out");
   }
+  if (cl.has("--frames") && !o.kitti) {
+    throw lsf::UsageError(
+        "--frames applies to the kitti protocol, which --protocols and --layouts leave out");
+  }
+
   return o;
 }
 

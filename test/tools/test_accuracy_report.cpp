@@ -1,5 +1,5 @@
-// accuracy_report's command line: an option for a protocol that does not run is refused with a
-// message naming it (exit 2, before any data is read), never ignored.
+// accuracy_report's command line: an option that only a protocol left out would read is refused
+// with a message naming it (exit 2, before any data is read), never ignored.
 #include <unistd.h>
 
 #include <filesystem>
@@ -36,6 +36,7 @@ TEST(AccuracyReportOptions, AnOptionForAProtocolThatDoesNotRunIsRefused) {
       {"--protocols synthetic --stereo-check 3", "--stereo-check applies to the dense"},
       {"--protocols kitti --keep-unverified", "--keep-unverified applies to the dense"},
       {"--layouts ring32 --reference majority", "--reference applies to the dense"},
+      {"--protocols dense --frames 2", "--frames applies to the kitti"},
   };
   for (const auto& c : cases) {
     const lsf::test::RunResult r = accuracyReport(c.args);
