@@ -148,15 +148,11 @@ std::string ringSourceName(RingSource source) {
   return "elevation";
 }
 
-namespace {
-
 int countRings(const LidarCloud& cloud) {
   int max_ring = -1;
   for (const LidarPoint& p : cloud) max_ring = std::max(max_ring, p.ring);
   return max_ring + 1;
 }
-
-}  // namespace
 
 std::string ringPlausibilityProblem(const LidarCloud& cloud, int max_rings) {
   const int rings = countRings(cloud);

@@ -145,15 +145,19 @@ void scoreDepthCaseAgainst(const DepthCase& c, const std::vector<DepthTarget>& t
   }
 }
 
+int distinctRings(const LidarCloud& cloud) {
+  std::set<int> rings;
+  for (const LidarPoint& p : cloud) rings.insert(p.ring);
+  return static_cast<int>(rings.size());
+}
+
 FedSweep fedSweep(const LidarCloud& cloud, const AccuracyOptions& options,
                   const kitti::Calibration& calib) {
   FedSweep out;
   ReorderedSweep sweep =
       reorderSweep(cloud, options.sweep_order, calib.T_cam_velo, calib.camera, 64, 7);
   out.cloud = std::move(sweep.cloud);
-  std::set<int> rings;
-  for (const LidarPoint& p : out.cloud) rings.insert(p.ring);
-  out.rings = static_cast<int>(rings.size());
+  out.rings = distinctRings(out.cloud);
   if (options.sweep_order != SweepOrder::kRecorded) {
     out.note = ", the sweep's order lost (" + sweepOrderName(options.sweep_order) +
                ", its rings recovered by " + ringSourceName(sweep.rings.source) + ")";

@@ -80,6 +80,9 @@ class LayoutAccumulator {
   std::map<std::string, MethodScores<Metrics>> rows_;
 };
 
+/// Distinct ring values of a cloud: the rings a layout feeds (fed_rings).
+int distinctRings(const LidarCloud& cloud);
+
 /// A KITTI sweep as the protocols feed it (options.sweep_order; eval/sweep_order.h).
 struct FedSweep {
   LidarCloud cloud;

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <numeric>
 #include <random>
-#include <set>
 #include <stdexcept>
 #include <tuple>
 
@@ -72,9 +71,7 @@ ReorderedSweep reorderSweep(const LidarCloud& cloud, SweepOrder order,
   ReorderedSweep out;
   if (order == SweepOrder::kRecorded) {
     out.cloud = cloud;
-    std::set<int> rings;
-    for (const LidarPoint& p : cloud) rings.insert(p.ring);
-    out.rings.rings = cloud.empty() ? 0 : *rings.rbegin() + 1;
+    out.rings.rings = countRings(cloud);
     return out;
   }
   const std::vector<std::size_t> indices =

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <ostream>
-#include <set>
 #include <stdexcept>
 
 #include "accuracy_common.h"
@@ -85,13 +84,12 @@ std::vector<LayoutScores<DepthMetrics>> runSyntheticDenseProtocol(
     kitti::Calibration calib;
     calib.camera = f.camera;
     calib.T_cam_velo = f.T_cam_lidar;
-    std::set<int> rings;
-    for (const LidarPoint& p : f.cloud) rings.insert(p.ring);
+    const int rings = distinctRings(f.cloud);
     std::vector<DepthTarget> targets;
     for (size_t i = 0; i < out.size(); ++i) {
       targets.push_back({out[i].name == "syn_exact" ? exact : lidar_made, acc[i]});
       out[i].items.push_back("seed " + std::to_string(seed));
-      out[i].fed_rings.push_back(static_cast<int>(rings.size()));
+      out[i].fed_rings.push_back(rings);
     }
     PmsRun pms;
     scoreDepthCaseAgainst({frame, frame.cloud, exact, calib}, targets, options, rows, pms);

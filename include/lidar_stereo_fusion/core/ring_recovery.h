@@ -94,6 +94,9 @@ enum class RingSource {
 /// "ring_field", "sweep_order", "beam_model" or "elevation".
 std::string ringSourceName(RingSource source);
 
+/// The scan lines a cloud's rings number: the largest ring + 1 (0 when no point has a ring).
+int countRings(const LidarCloud& cloud);
+
 /// Outcome of ensureRings(): the method used, the rings it found, and why earlier methods were
 /// passed over (empty when the first one was plausible).
 struct RingRecovery {
