@@ -216,6 +216,46 @@ TEST(PatchMatch, SearchScale2EndsWithTheSubpixelStepAtHalfSize) {
   EXPECT_LT(error[1], 0.93 * error[0]) << error[1] << " against " << error[0];
 }
 
+TEST(PatchMatch, FullSearchPixelsSearchesASmallImageInFull) {
+  lsf::PatchMatchParams p;
+  p.search_scale = 2;  // the live preset's cuts
+  p.intermediate_refine = false;
+  EXPECT_EQ(p.forImage(450, 375).search_scale, 2);  // 0: never
+  p.full_search_pixels = 200000;                    // the live preset
+  for (const cv::Size& size : {cv::Size(450, 375), cv::Size(500, 400), cv::Size(400, 500)}) {
+    const lsf::PatchMatchParams q = p.forImage(size.width, size.height);
+    EXPECT_EQ(q.search_scale, 1) << size;  // Middlebury's quarter size; exactly the budget
+    EXPECT_TRUE(q.intermediate_refine) << size;
+    EXPECT_EQ(q.full_search_pixels, p.full_search_pixels);  // the rest as set
+  }
+  for (const cv::Size& size : {cv::Size(501, 400), cv::Size(1242, 375), cv::Size(1280, 720)}) {
+    const lsf::PatchMatchParams q = p.forImage(size.width, size.height);
+    EXPECT_EQ(q.search_scale, 2) << size;  // one pixel more; KITTI; the rig
+    EXPECT_FALSE(q.intermediate_refine) << size;
+  }
+  p.full_search_pixels = -1;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+
+  // The search is the full one, bit for bit, up to the budget; params() stays as set.
+  const PlaneScene s = PlaneScene::make(96, 48, 0.04, 0.0, 7.0, 5);
+  const lsf::ViewInput left{s.left, cv::Mat1f(), {}}, right{s.right, cv::Mat1f(), {}};
+  lsf::PatchMatchParams q = stereoOnly();
+  q.max_disparity = 16;
+  q.num_threads = 1;
+  const cv::Mat1f full = lsf::PatchMatchStereo(q).compute(left, right).disparity;
+  q.search_scale = 2;
+  q.intermediate_refine = false;
+  const cv::Mat1f cut = lsf::PatchMatchStereo(q).compute(left, right).disparity;
+  ASSERT_GT(cv::norm(full, cut, cv::NORM_INF), 0.0);  // the two searches differ here
+  for (const int budget : {96 * 48, 96 * 48 - 1}) {
+    q.full_search_pixels = budget;
+    lsf::PatchMatchStereo solver(q);
+    const cv::Mat1f d = solver.compute(left, right).disparity;
+    EXPECT_EQ(cv::norm(d, budget == 96 * 48 ? full : cut, cv::NORM_INF), 0.0) << budget;
+    EXPECT_EQ(solver.params().search_scale, 2);
+  }
+}
+
 TEST(PatchMatch, RejectsBadInput) {
   lsf::PatchMatchParams p;
   p.alpha = 0.5;  // sum != 1

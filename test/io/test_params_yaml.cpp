@@ -82,6 +82,7 @@ FusionParams everyFieldChanged() {
   m.search_scale = 3;
   m.skip_inconsistent = false;
   m.intermediate_refine = false;
+  m.full_search_pixels = 123456;
   m.fine_iterations = 2;
   m.fine_refine_range = 1.5;
   p.confidence.edge_tolerance = 0.25;
@@ -143,6 +144,7 @@ void expectSame(const FusionParams& a, const FusionParams& b) {
   EXPECT_EQ(x.unbounded_scale, y.unbounded_scale);
   EXPECT_EQ(x.search_scale, y.search_scale);
   EXPECT_EQ(x.intermediate_refine, y.intermediate_refine);
+  EXPECT_EQ(x.full_search_pixels, y.full_search_pixels);
   EXPECT_EQ(x.fine_iterations, y.fine_iterations);
   EXPECT_EQ(x.fine_refine_range, y.fine_refine_range);
   const PriorConfidenceParams &c = a.confidence, &d = b.confidence;
@@ -287,9 +289,11 @@ TEST(ParamsYaml, TheLivePresetCutsTheSearchOnly) {
   EXPECT_EQ(p.method, Method::kFusedBI);
   EXPECT_EQ(p.patchmatch.search_scale, 2);
   EXPECT_FALSE(p.patchmatch.intermediate_refine);
+  EXPECT_EQ(p.patchmatch.full_search_pixels, 200000);  // but not on images that small
   FusionParams expected;
   expected.patchmatch.search_scale = 2;
   expected.patchmatch.intermediate_refine = false;
+  expected.patchmatch.full_search_pixels = 200000;
   expectSame(p, expected);
 }
 

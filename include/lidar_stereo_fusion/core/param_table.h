@@ -236,6 +236,10 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
               "Coarse start, the 1/2-size level of three: the right view refines and hands its "
               "planes back"},
     p.intermediate_refine);
+  v(ParamSpec{"full_search_pixels", g, atLeast(0), "px",
+              "An image of at most this many pixels is searched in full: search_scale 1, "
+              "intermediate_refine true (0 = never)"},
+    p.full_search_pixels);
   v(ParamSpec{"fine_iterations", g, within(1, PM::kMaxIterations), "",
               "Sweeps per larger level after the coarse start"},
     p.fine_iterations);

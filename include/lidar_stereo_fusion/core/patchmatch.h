@@ -28,7 +28,7 @@ class PatchMatchStereo {
  public:
   explicit PatchMatchStereo(const PatchMatchParams& params = PatchMatchParams());
   void setParams(const PatchMatchParams& params);
-  const PatchMatchParams& params() const { return params_; }
+  const PatchMatchParams& params() const { return configured_; }
   /// Whether compute() returns the plane maps (PatchMatchResult::planes, right_planes; the
   /// default): without them, a frame maps and allocates two full-size images less (the fusion
   /// pipeline reads the disparity alone).
@@ -38,7 +38,8 @@ class PatchMatchStereo {
   PatchMatchResult compute(const ViewInput& left, const ViewInput& right);
 
  private:
-  PatchMatchParams params_;
+  PatchMatchParams configured_;  ///< as set
+  PatchMatchParams params_;      ///< as the current compute() runs them (forImage())
   struct Scratch;
   std::shared_ptr<Scratch> scratch_;
   std::shared_ptr<PatchMatchStereo> coarse_;  ///< the coarse start's solver (coarse_scale > 1)

@@ -1,5 +1,6 @@
 // PatchMatch: the parameters' checks (PatchMatchParams::validate, patchmatch/params.h).
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -48,6 +49,16 @@ void PatchMatchParams::validate() const {
           "reduction factor)");
   require(simdPathSupported(simd_path), std::string("simd_path ") + simdPathName(simd_path) +
                                             ": this CPU (or build) does not run it");
+}
+
+PatchMatchParams PatchMatchParams::forImage(int width, int height) const {
+  PatchMatchParams p = *this;
+  if (full_search_pixels > 0 &&
+      static_cast<int64_t>(width) * height <= static_cast<int64_t>(full_search_pixels)) {
+    p.search_scale = 1;
+    p.intermediate_refine = true;
+  }
+  return p;
 }
 
 }  // namespace lidar_stereo_fusion

@@ -131,6 +131,7 @@ void PatchMatchStereo::setPlanesOutput(bool planes) { planes_wanted_ = planes; }
 
 void PatchMatchStereo::setParams(const PatchMatchParams& params) {
   params.validate();
+  configured_ = params;
   params_ = params;
 }
 
@@ -178,6 +179,7 @@ PatchMatchResult PatchMatchStereo::compute(const ViewInput& left, const ViewInpu
   if (!scratch_) scratch_ = std::make_shared<Scratch>();
   if (!steps_) steps_ = std::make_shared<Steps>();
   steps_->start(level_scale_);
+  if (!intermediate_) params_ = configured_.forImage(size.width, size.height);
   const bool guided = hasCoarseStart(params_, size);
   PatchMatchResult result;
   if (guided && params_.search_scale > 1) {
