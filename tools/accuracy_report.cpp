@@ -44,14 +44,15 @@ KITTI devkit (interpolateBackground) before scoring.
     fed: syn_lidar scores against a reference made of LiDAR returns as KITTI's is (sweeps of
     frames 0-10, the nearest point per pixel, each return widened by its beam's footprint),
     syn_exact against the exact depth at the same pixels: the same outputs, so the two show
-    what a LiDAR-made reference does to each method's score.
+    what a LiDAR-made reference does to each method's score; syn_image against the exact depth
+    at every pixel with a surface, above the LiDAR's view too (where the images alone decide).
 
 Options:
   --data <dir>          the shared data folder (default: env LSF_DATA_DIR, else the build's
                         ../shared/data next to the source tree)
   --protocols <list>    comma-separated subset of middlebury,kitti,dense,synthetic (default all)
   --layouts <list>      comma-separated subset of mb64,mb16,mb42low,ring32,ring16,dense,
-                        syn_exact,syn_lidar (default all); a protocol runs only when one of its
+                        syn_exact,syn_lidar,syn_image (default all); a protocol runs only when one of its
                         layouts is chosen
   --frames N            the first N KITTI ring hold-out frames (default all 11)
   --no-kitti-pms        skip pms and "lidar_bi else pms" on KITTI, ring and dense, and on the
@@ -135,7 +136,7 @@ Options parseOptions(int argc, char** argv) {
         !anyChosen({layout}, lsf::syntheticLayoutNames())) {
       throw lsf::UsageError(
           "--layouts: unknown layout '" + layout +
-          "' (valid: mb64, mb16, mb42low, ring32, ring16, dense, syn_exact, syn_lidar)");
+          "' (valid: mb64, mb16, mb42low, ring32, ring16, dense, syn_exact, syn_lidar, syn_image)");
     }
   }
   if (cl.has("--protocols")) {

@@ -124,7 +124,7 @@ std::vector<std::string> accuracyMethodNames() {
 std::vector<std::string> middleburyLayoutNames() { return {"mb64", "mb16", "mb42low"}; }
 std::vector<std::string> kittiLayoutNames() { return {"ring32", "ring16"}; }
 std::vector<std::string> denseLayoutNames() { return {"dense"}; }
-std::vector<std::string> syntheticLayoutNames() { return {"syn_exact", "syn_lidar"}; }
+std::vector<std::string> syntheticLayoutNames() { return {"syn_exact", "syn_lidar", "syn_image"}; }
 
 void AccuracyOptions::validate() const {
   for (const std::string& m : methods) {

@@ -87,7 +87,12 @@ std::vector<LayoutScores<DepthMetrics>> runSyntheticDenseProtocol(
     const int rings = distinctRings(f.cloud);
     std::vector<DepthTarget> targets;
     for (size_t i = 0; i < out.size(); ++i) {
-      targets.push_back({out[i].name == "syn_exact" ? exact : lidar_made, acc[i]});
+      const std::string& name = out[i].name;
+      // syn_image: every pixel with a surface (f.depth is 0 on the sky), above the LiDAR too.
+      targets.push_back({name == "syn_exact"   ? exact
+                         : name == "syn_lidar" ? lidar_made
+                                               : f.depth,
+                         acc[i]});
       out[i].items.push_back("seed " + std::to_string(seed));
       out[i].fed_rings.push_back(rings);
     }
@@ -100,15 +105,20 @@ std::vector<LayoutScores<DepthMetrics>> runSyntheticDenseProtocol(
       "), frame " + std::to_string(params.frame) + ", the full 64-ring sweep fed, scored against ";
   for (size_t i = 0; i < out.size(); ++i) {
     out[i].methods = acc[i].finish();
-    out[i].description =
-        what + (out[i].name == "syn_exact"
-                    ? std::string("the exact depth at the pixels of syn_lidar's reference")
-                    : "a reference made of LiDAR returns like KITTI's: the sweeps of frames " +
-                          std::to_string(params.frame - params.half_span) + "-" +
-                          std::to_string(params.frame + params.half_span) +
-                          " from their exact poses, the nearest point per pixel, each return "
-                          "widened by " +
-                          std::to_string(params.footprint_px) + " px either side (beam footprint)");
+    if (out[i].name == "syn_exact") {
+      out[i].description = what + "the exact depth at the pixels of syn_lidar's reference";
+    } else if (out[i].name == "syn_image") {
+      out[i].description = what +
+                           "the exact depth at every pixel with a surface (not the sky), above "
+                           "the LiDAR's view too, where the images alone decide";
+    } else {
+      out[i].description =
+          what + "a reference made of LiDAR returns like KITTI's: the sweeps of frames " +
+          std::to_string(params.frame - params.half_span) + "-" +
+          std::to_string(params.frame + params.half_span) +
+          " from their exact poses, the nearest point per pixel, each return widened by " +
+          std::to_string(params.footprint_px) + " px either side (beam footprint)";
+    }
   }
   return out;
 }

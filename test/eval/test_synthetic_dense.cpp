@@ -132,9 +132,10 @@ TEST(SyntheticDenseProtocol, ScoresTheSameOutputsAtTheSamePixelsAgainstBothRefer
   lsf::SyntheticDenseParams params;
   params.seeds = {1};
   const auto layouts = lsf::runSyntheticDenseProtocol(options, params);
-  ASSERT_EQ(layouts.size(), 2u);
+  ASSERT_EQ(layouts.size(), 3u);
   EXPECT_EQ(layouts[0].name, "syn_exact");
   EXPECT_EQ(layouts[1].name, "syn_lidar");
+  EXPECT_EQ(layouts[2].name, "syn_image");
   const auto* exact_fused = layouts[0].find("fused");
   const auto* exact_ipb = layouts[0].find("ip_basic");
   const auto* lidar_fused = layouts[1].find("fused");
@@ -145,6 +146,12 @@ TEST(SyntheticDenseProtocol, ScoresTheSameOutputsAtTheSamePixelsAgainstBothRefer
   EXPECT_EQ(e.count, lidar_fused->mean[0].count);
   EXPECT_LT(e.mae_mm, 0.8 * exact_ipb->mean[0].mae_mm);
   EXPECT_GT(lidar_fused->mean[0].mae_mm, e.mae_mm);
+  // syn_image: every pixel with a surface, a superset of the LiDAR-made reference's pixels; the
+  // region above the LiDAR's view, where the images alone decide, adds error.
+  const auto* image_fused = layouts[2].find("fused");
+  ASSERT_TRUE(image_fused);
+  EXPECT_GT(image_fused->mean[0].count, e.count + 20000);
+  EXPECT_GT(image_fused->mean[0].mae_mm, e.mae_mm);
   options.layouts = {"syn_lidar"};
   EXPECT_EQ(lsf::runSyntheticDenseProtocol(options, params).size(), 1u);
 }
