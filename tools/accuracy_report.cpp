@@ -52,8 +52,8 @@ Options:
                         ../shared/data next to the source tree)
   --protocols <list>    comma-separated subset of middlebury,kitti,dense,synthetic (default all)
   --layouts <list>      comma-separated subset of mb64,mb16,mb42low,ring32,ring16,dense,
-                        syn_exact,syn_lidar,syn_image (default all); a protocol runs only when one of its
-                        layouts is chosen
+                        syn_exact,syn_lidar,syn_image (default all); a protocol runs only when
+                        one of its layouts is chosen
   --frames N            the first N KITTI ring hold-out frames (default all 11)
   --no-kitti-pms        skip pms and "lidar_bi else pms" on KITTI, ring and dense, and on the
                         synthetic street (~15 s a frame)
