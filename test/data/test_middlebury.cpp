@@ -3,12 +3,15 @@
 // every ground-truth pixel after the KITTI devkit's fill. On every layout (mean of the two scenes)
 // the default fused method, and the live preset (config/live.yaml), must each have a lower MAE and
 // a lower bad-2 rate than each of LiDAR-only BI*, plain PMS, "LiDAR-only else PMS" and the
-// nearest-point fill, by a margin; and the paper preset must reproduce the fused_bi numbers of the
-// package before confidence weighting. Above the LiDAR where both views see the pixel, both presets
-// stay near plain PMS.
+// nearest-point fill, by a margin, also on the scenes turned upside down; and the paper preset must
+// reproduce the fused_bi numbers of the package before confidence weighting. Above the LiDAR where
+// both views see the pixel, both presets stay near plain PMS.
+#include <filesystem>
 #include <iostream>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "data/data_guard.h"
 #include "lidar_stereo_fusion/eval/accuracy_protocols.h"
@@ -28,43 +31,72 @@ const DisparityMetrics& all(const LayoutScores<DisparityMetrics>& layout, const 
   return scores->mean[static_cast<int>(Region::kAll)];
 }
 
-const std::vector<LayoutScores<DisparityMetrics>>& results() {
-  static const std::vector<LayoutScores<DisparityMetrics>> layouts = [] {
-    AccuracyOptions options;
-    options.data_dir = LSF_DATA_DIR;
+using Layouts = std::vector<LayoutScores<DisparityMetrics>>;
+
+/// Both scenes turned upside down (images and ground truth, rows reversed: still a rectified
+/// pair), written once into the test's temporary folder: the lower 2/3's top third, where
+/// stereo alone decides, is then another part of each scene, one nothing was tuned on.
+std::string flippedDataDir() {
+  static const std::string dir = [] {
+    const std::filesystem::path root =
+        std::filesystem::path(::testing::TempDir()) / "lsf_middlebury_flipped";
+    for (const char* scene : {"cones", "teddy"}) {
+      std::filesystem::create_directories(root / "middlebury" / scene);
+      for (const char* file : {"im2.png", "im6.png", "disp2.png"}) {
+        const std::string from = test::dataPath(std::string("middlebury/") + scene + "/" + file);
+        const cv::Mat image = cv::imread(from, cv::IMREAD_UNCHANGED);
+        if (image.empty()) throw std::runtime_error("cannot read " + from);
+        cv::Mat flipped;
+        cv::flip(image, flipped, 0);
+        cv::imwrite((root / "middlebury" / scene / file).string(), flipped);
+      }
+    }
+    return root.string();
+  }();
+  return dir;
+}
+
+/// The default (or, with `live`, the live preset alone as the "fused" row) on the scenes in
+/// `data_dir`, with the baselines.
+Layouts run(const std::string& data_dir, bool live) {
+  AccuracyOptions options;
+  options.data_dir = data_dir;
+  if (live) {
+    loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/live.yaml", options.fused);
+    options.methods = {"fused"};
+  } else {
     FusionParams paper;
     loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/paper.yaml", paper);
     options.paper = paper;
     options.methods = {"fused", "paper", "lidar_bi", "pms", "lidar_bi else pms", "nearest"};
-    return runMiddleburyProtocol(options);
-  }();
+  }
+  return runMiddleburyProtocol(options);
+}
+
+const Layouts& results() {
+  static const Layouts layouts = run(LSF_DATA_DIR, false);
   return layouts;
 }
 
 /// The live preset as the "fused" row, alone.
-const std::vector<LayoutScores<DisparityMetrics>>& liveResults() {
-  static const std::vector<LayoutScores<DisparityMetrics>> layouts = [] {
-    AccuracyOptions options;
-    options.data_dir = LSF_DATA_DIR;
-    loadParamsYaml(std::string(LSF_SOURCE_DIR) + "/config/live.yaml", options.fused);
-    options.methods = {"fused"};
-    return runMiddleburyProtocol(options);
-  }();
+const Layouts& liveResults() {
+  static const Layouts layouts = run(LSF_DATA_DIR, true);
   return layouts;
 }
 
-const DisparityMetrics& liveScore(const std::string& name) {
-  for (const auto& layout : liveResults()) {
+const DisparityMetrics& liveScore(const Layouts& live_layouts, const std::string& name) {
+  for (const auto& layout : live_layouts) {
     if (layout.name == name) return all(layout, "fused");
   }
   throw std::runtime_error("layout " + name + " did not run with the live preset");
 }
 
-void expectFusedBeatsEveryBaseline(const std::string& name) {
-  for (const auto& layout : results()) {
+void expectFusedBeatsEveryBaseline(const std::string& name, const Layouts& layouts = results(),
+                                   const Layouts& live_layouts = liveResults()) {
+  for (const auto& layout : layouts) {
     if (layout.name != name) continue;
     const DisparityMetrics& fused = all(layout, "fused");
-    const DisparityMetrics& live = liveScore(name);
+    const DisparityMetrics& live = liveScore(live_layouts, name);
     std::cout << name << ": fused MAE " << fused.mae_px << " px, bad-2 " << 100 * fused.bad2
               << " %; live MAE " << live.mae_px << " px, bad-2 " << 100 * live.bad2 << " %\n";
     for (const char* baseline : {"lidar_bi", "pms", "lidar_bi else pms", "nearest"}) {
@@ -99,12 +131,26 @@ TEST(Middlebury, FusedBeatsEveryBaselineWithRowsInTheLowerTwoThirdsOnly) {
   expectFusedBeatsEveryBaseline("mb42low");
 }
 
+// The same orderings on the scenes turned upside down, on every layout. Where `live` searched
+// these small images at 1/4 and 1/2 size only, it lost the lower 2/3's bad-2 rate to "LiDAR-only
+// else PMS" there (6.40 against 6.37 % at seed 42); with the full search (full_search_pixels) it
+// has 4.71 % (doc/performance.md).
+TEST(Middlebury, FusedBeatsEveryBaselineOnTheScenesUpsideDown) {
+  LSF_REQUIRE_DATA("middlebury/cones");
+  LSF_REQUIRE_DATA("middlebury/teddy");
+  const Layouts flipped = run(flippedDataDir(), false);
+  const Layouts flipped_live = run(flippedDataDir(), true);
+  for (const char* name : {"mb64", "mb16", "mb42low"}) {
+    expectFusedBeatsEveryBaseline(name, flipped, flipped_live);
+  }
+}
+
 // Above the LiDAR (the lower 2/3's top third), where both images see the pixel (region "above,
 // both views": the left border band the right image does not see is left out), only stereo
 // decides. There the default, which searches it at full size, must stay within 15 % of plain PMS
-// (0.348 against 0.330 px at seed 42); `live`, which searches it at 1/4 and 1/2 size only, within
-// 50 % (0.457 px). A guard for the speed work, not the goal: issue 32 wants `live` ahead there, and
-// only a full-size search has closed the gap so far (doc/accuracy.md).
+// (0.348 against 0.330 px at seed 42), and so must `live`: these images are below its
+// full_search_pixels, so it searches them as the default does (cut to 1/4 and 1/2 size it had
+// 0.457 px; doc/accuracy.md).
 TEST(Middlebury, AboveTheLidarWhereBothViewsSeeThePixelStereoStaysNearPlainPms) {
   LSF_REQUIRE_DATA("middlebury/cones");
   LSF_REQUIRE_DATA("middlebury/teddy");
@@ -123,7 +169,7 @@ TEST(Middlebury, AboveTheLidarWhereBothViewsSeeThePixelStereoStaysNearPlainPms) 
       if (live_layout.name != "mb42low") continue;
       const DisparityMetrics live = region(live_layout, "fused");
       EXPECT_EQ(live.count, pms.count);
-      EXPECT_LT(live.mae_px, 1.5 * pms.mae_px);
+      EXPECT_LT(live.mae_px, 1.15 * pms.mae_px);
       std::cout << "above, both views: fused " << fused.mae_px << " px, live " << live.mae_px
                 << " px, pms " << pms.mae_px << " px\n";
       return;
