@@ -8,8 +8,11 @@
 // both views see the pixel, both presets stay near plain PMS.
 #include <filesystem>
 #include <iostream>
+#include <string>
+#include <system_error>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -34,27 +37,36 @@ const DisparityMetrics& all(const LayoutScores<DisparityMetrics>& layout, const 
 using Layouts = std::vector<LayoutScores<DisparityMetrics>>;
 
 /// Both scenes turned upside down (images and ground truth, rows reversed: still a rectified
-/// pair), written once into the test's temporary folder: the lower 2/3's top third, where
+/// pair) in a temporary data folder, removed with the object: the lower 2/3's top third, where
 /// stereo alone decides, is then another part of each scene, one nothing was tuned on.
-std::string flippedDataDir() {
-  static const std::string dir = [] {
-    const std::filesystem::path root =
-        std::filesystem::path(::testing::TempDir()) / "lsf_middlebury_flipped";
+class FlippedScenes {
+ public:
+  FlippedScenes()
+      : root_(std::filesystem::temp_directory_path() /
+              ("lsf_middlebury_flipped_" + std::to_string(::getpid()))) {
     for (const char* scene : {"cones", "teddy"}) {
-      std::filesystem::create_directories(root / "middlebury" / scene);
+      std::filesystem::create_directories(root_ / "middlebury" / scene);
       for (const char* file : {"im2.png", "im6.png", "disp2.png"}) {
         const std::string from = test::dataPath(std::string("middlebury/") + scene + "/" + file);
         const cv::Mat image = cv::imread(from, cv::IMREAD_UNCHANGED);
         if (image.empty()) throw std::runtime_error("cannot read " + from);
         cv::Mat flipped;
         cv::flip(image, flipped, 0);
-        cv::imwrite((root / "middlebury" / scene / file).string(), flipped);
+        cv::imwrite((root_ / "middlebury" / scene / file).string(), flipped);
       }
     }
-    return root.string();
-  }();
-  return dir;
-}
+  }
+  ~FlippedScenes() {
+    std::error_code ignored;
+    std::filesystem::remove_all(root_, ignored);
+  }
+  FlippedScenes(const FlippedScenes&) = delete;
+  FlippedScenes& operator=(const FlippedScenes&) = delete;
+  std::string dataDir() const { return root_.string(); }
+
+ private:
+  std::filesystem::path root_;
+};
 
 /// The default (or, with `live`, the live preset alone as the "fused" row) on the scenes in
 /// `data_dir`, with the baselines.
@@ -138,8 +150,9 @@ TEST(Middlebury, FusedBeatsEveryBaselineWithRowsInTheLowerTwoThirdsOnly) {
 TEST(Middlebury, FusedBeatsEveryBaselineOnTheScenesUpsideDown) {
   LSF_REQUIRE_DATA("middlebury/cones");
   LSF_REQUIRE_DATA("middlebury/teddy");
-  const Layouts flipped = run(flippedDataDir(), false);
-  const Layouts flipped_live = run(flippedDataDir(), true);
+  const FlippedScenes scenes;
+  const Layouts flipped = run(scenes.dataDir(), false);
+  const Layouts flipped_live = run(scenes.dataDir(), true);
   for (const char* name : {"mb64", "mb16", "mb42low"}) {
     expectFusedBeatsEveryBaseline(name, flipped, flipped_live);
   }
