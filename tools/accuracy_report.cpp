@@ -130,13 +130,9 @@ Options parseOptions(int argc, char** argv) {
   if (cl.has("--methods")) o.methods = splitList(cl.value("--methods"));
   if (cl.has("--layouts")) o.layouts = splitList(cl.value("--layouts"));
   for (const std::string& layout : o.layouts) {
-    if (!anyChosen({layout}, lsf::middleburyLayoutNames()) &&
-        !anyChosen({layout}, lsf::kittiLayoutNames()) &&
-        !anyChosen({layout}, lsf::denseLayoutNames()) &&
-        !anyChosen({layout}, lsf::syntheticLayoutNames())) {
-      throw lsf::UsageError(
-          "--layouts: unknown layout '" + layout +
-          "' (valid: mb64, mb16, mb42low, ring32, ring16, dense, syn_exact, syn_lidar, syn_image)");
+    if (!anyChosen({layout}, lsf::accuracyLayoutNames())) {
+      throw lsf::UsageError("--layouts: unknown layout '" + layout +
+                            "' (valid: " + lsf::joinedNames(lsf::accuracyLayoutNames()) + ")");
     }
   }
   if (cl.has("--protocols")) {

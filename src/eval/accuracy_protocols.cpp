@@ -126,20 +126,32 @@ std::vector<std::string> kittiLayoutNames() { return {"ring32", "ring16"}; }
 std::vector<std::string> denseLayoutNames() { return {"dense"}; }
 std::vector<std::string> syntheticLayoutNames() { return {"syn_exact", "syn_lidar", "syn_image"}; }
 
+std::vector<std::string> accuracyLayoutNames() {
+  std::vector<std::string> all;
+  for (const auto& names :
+       {middleburyLayoutNames(), kittiLayoutNames(), denseLayoutNames(), syntheticLayoutNames()}) {
+    all.insert(all.end(), names.begin(), names.end());
+  }
+  return all;
+}
+
+std::string joinedNames(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
 void AccuracyOptions::validate() const {
   for (const std::string& m : methods) {
     if (!contains(accuracyMethodNames(), m)) {
       throw std::invalid_argument("AccuracyOptions: unknown method '" + m +
-                                  "' (valid: fused, paper, lidar_bi, lidar_bf, pms, "
-                                  "lidar_bi else pms, nearest, ip_basic)");
+                                  "' (valid: " + joinedNames(accuracyMethodNames()) + ")");
     }
   }
   for (const std::string& l : layouts) {
-    if (!contains(middleburyLayoutNames(), l) && !contains(kittiLayoutNames(), l) &&
-        !contains(denseLayoutNames(), l) && !contains(syntheticLayoutNames(), l)) {
-      throw std::invalid_argument(
-          "AccuracyOptions: unknown layout '" + l +
-          "' (valid: mb64, mb16, mb42low, ring32, ring16, dense, syn_exact, syn_lidar)");
+    if (!contains(accuracyLayoutNames(), l)) {
+      throw std::invalid_argument("AccuracyOptions: unknown layout '" + l +
+                                  "' (valid: " + joinedNames(accuracyLayoutNames()) + ")");
     }
   }
   if (kitti_frames < 0) throw std::invalid_argument("AccuracyOptions: kitti_frames must be >= 0");

@@ -134,7 +134,7 @@ struct MethodScores {
 /// One layout (a pseudo-LiDAR of a given density, a ring subset) of one protocol.
 template <typename Metrics>
 struct LayoutScores {
-  std::string name;                ///< "mb64", ..., "ring16", "dense", "syn_exact", "syn_lidar"
+  std::string name;                ///< one of accuracyLayoutNames()
   std::string description;         ///< one line for the table title
   std::vector<std::string> items;  ///< scene or frame names
   std::vector<MethodScores<Metrics>> methods;
@@ -175,6 +175,10 @@ std::vector<std::string> middleburyLayoutNames();
 std::vector<std::string> kittiLayoutNames();
 std::vector<std::string> denseLayoutNames();
 std::vector<std::string> syntheticLayoutNames();  ///< eval/synthetic_dense.h
+/// Every protocol's layout names, in the order above.
+std::vector<std::string> accuracyLayoutNames();
+/// `names` joined by ", " (the valid names in a message).
+std::string joinedNames(const std::vector<std::string>& names);
 
 /// Middlebury pseudo-LiDAR of a layout ("mb64", "mb16", "mb42low") for a ground-truth map [px].
 /// Throws std::invalid_argument for an unknown layout.

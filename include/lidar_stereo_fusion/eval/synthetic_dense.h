@@ -1,12 +1,14 @@
 // The dense-LiDAR protocol on the synthetic street (sim/synthetic_frame.h), where the exact depth
-// is known: the full 64-ring sweep of a frame fed to every method, each scored twice, against
+// is known: the full 64-ring sweep of a frame fed to every method, each scored three times,
+// against
 //   syn_lidar: a reference made the way KITTI's is, of LiDAR returns: the sweeps of the frames
 //     around it cast from their exact poses, projected into the frame's left camera, the nearest
-//     point winning a pixel, each return widened over its beam's footprint, and
-//   syn_exact: the exact depth at the same pixels (where the surface is not sky).
-// The two layouts score the same outputs at the same pixels, so the difference between them is
-// what building the reference from LiDAR returns does to a method's score (doc/accuracy.md,
-// issue 31). No data files are read. ROS-free.
+//     point winning a pixel, each return widened over its beam's footprint,
+//   syn_exact: the exact depth at the same pixels (where the surface is not sky), and
+//   syn_image: the exact depth at every pixel with a surface, above the LiDAR's view too.
+// syn_exact and syn_lidar score the same outputs at the same pixels, so the difference between
+// them is what building the reference from LiDAR returns does to a method's score
+// (doc/accuracy.md, issue 31). No data files are read. ROS-free.
 #pragma once
 
 #include <cstdint>
@@ -43,9 +45,10 @@ struct SyntheticDenseParams {
 cv::Mat1f syntheticLidarReference(const sim::Scene& scene, const sim::SyntheticParams& params,
                                   int target, int half_span, int footprint_px);
 
-/// Runs the protocol's wanted layouts (syntheticLayoutNames(): syn_exact, syn_lidar) with every
-/// wanted method of `options` (pms and "lidar_bi else pms" only when options.kitti_pms); items
-/// are the seeds. Methods run once per seed and are scored against both references.
+/// Runs the protocol's wanted layouts (syntheticLayoutNames(): syn_exact, syn_lidar, syn_image)
+/// with every wanted method of `options` (pms and "lidar_bi else pms" only when
+/// options.kitti_pms); items are the seeds. Methods run once per seed and are scored against
+/// every wanted reference.
 std::vector<LayoutScores<DepthMetrics>> runSyntheticDenseProtocol(
     const AccuracyOptions& options, const SyntheticDenseParams& params = {});
 
