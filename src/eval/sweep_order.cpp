@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "lidar_stereo_fusion/eval/accuracy_protocols.h"
+
 namespace lidar_stereo_fusion {
 
 std::vector<std::string> sweepOrderNames() {
@@ -22,8 +24,8 @@ SweepOrder parseSweepOrder(const std::string& name) {
   const std::vector<std::string> names = sweepOrderNames();
   const auto it = std::find(names.begin(), names.end(), name);
   if (it == names.end()) {
-    throw std::invalid_argument("unknown sweep order '" + name +
-                                "' (valid: recorded, shuffled, image-rows, image-rows-cropped)");
+    throw std::invalid_argument("unknown sweep order '" + name + "' (valid: " + joinedNames(names) +
+                                ")");
   }
   return static_cast<SweepOrder>(it - names.begin());
 }
