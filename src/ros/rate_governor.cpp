@@ -19,7 +19,9 @@ std::string EffortStep::describe() const {
   return "search from " + sizeText(coarsest_scale) +
          ", pixels without scan-line bounds searched down to " + sizeText(unbounded_scale) + ", " +
          std::to_string(iterations) + (iterations == 1 ? " sweep" : " sweeps") +
-         " at the coarsest level";
+         " at the coarsest level" +
+         (refine_between ? ""
+                         : ", the right view not refined between the coarsest level and full size");
 }
 
 std::vector<EffortStep> effortSteps(const FusionParams& base) {
@@ -32,22 +34,31 @@ std::vector<EffortStep> effortSteps(const FusionParams& base) {
   // Pixels without bounds are searched no finer than the finest level that searches at all.
   std::vector<EffortStep> steps{EffortStep{p.coarse_levels, coarsestOf(p.coarse_levels),
                                            std::max(p.unbounded_scale, p.search_scale),
-                                           p.iterations}};
+                                           p.iterations, true}};
   if (!isFused(base.method) || p.coarse_levels < 1 || p.coarse_scale < 2) return steps;
-  // For each scale pixels without bounds are searched down to, from the configured one to the
-  // configured coarsest level: the configured levels, then one more coarse level. Each step is
-  // faster than the one before (KITTI frame 0, `live`: 1.00, 0.80, 0.74, 0.58x SGBM; the default:
-  // 2.17, 2.01, 1.82, 1.69, 1.40, 1.25x; doc/performance.md).
   const int coarsest = coarsestOf(p.coarse_levels);
   const bool extra_level = p.coarse_levels < PatchMatchParams::kMaxCoarseLevels;
+  const auto deeper = [&](EffortStep e) {
+    e.coarse_levels = p.coarse_levels + 1;
+    e.coarsest_scale = coarsestOf(e.coarse_levels);
+    return e;
+  };
   EffortStep s = steps.back();
+  // Where a level between the coarsest and the finest refines its right view and hands it back
+  // (the default), giving that up is the first step, and after it a coarser search without
+  // bounds costs less above the LiDAR than one more level, which comes last (KITTI frame 0, the
+  // default: 2.2, 1.8, 1.5, 1.3x SGBM, then 1.1x with one more level; one more level right after
+  // the first step: 1.6x, with 1.4 times the error above the LiDAR of the 1.5x step). Where they
+  // only propagate (`live`): for each scale pixels without bounds are searched down to, from the
+  // configured one to the configured coarsest level, the configured levels, then one more level
+  // (1.00, 0.80, 0.74, 0.58x SGBM). Each step is faster than the one before (doc/performance.md).
+  const bool refine_first = p.intermediate_refine && p.coarse_levels >= 2;
+  if (refine_first) {
+    s.refine_between = false;
+    steps.push_back(s);
+  }
   for (;;) {
-    if (extra_level) {
-      EffortStep deeper = s;
-      deeper.coarse_levels = p.coarse_levels + 1;
-      deeper.coarsest_scale = coarsestOf(deeper.coarse_levels);
-      steps.push_back(deeper);
-    }
+    if (extra_level && (!refine_first || s.unbounded_scale >= coarsest)) steps.push_back(deeper(s));
     if (s.unbounded_scale >= coarsest) break;
     s.unbounded_scale *= p.coarse_scale;
     steps.push_back(s);
@@ -77,6 +88,8 @@ FusionParams RateGovernor::params() const {
   p.patchmatch.coarse_levels = current().coarse_levels;
   p.patchmatch.unbounded_scale = current().unbounded_scale;
   p.patchmatch.iterations = current().iterations;
+  p.patchmatch.intermediate_refine =
+      base_.patchmatch.intermediate_refine && current().refine_between;
   return p;
 }
 

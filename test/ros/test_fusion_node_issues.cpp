@@ -234,7 +234,9 @@ TEST_F(FusionNode, KeepRate_DroppedSetsMakeTheSearchCoarserAndTheNodeSaysWhy) {
     }
     h().waitForOutputs(last, 5.0);
     said = h().waitForLog(
-        mark, {"keep_rate", "dropped input sets", "step 1 of 5", "search from 1/8 size"}, 0.5);
+        mark,
+        {"keep_rate", "dropped input sets", "step 1 of 4", "the right view not refined between"},
+        0.5);
   }
   ASSERT_TRUE(said) << h().logsSince(mark);
   ASSERT_TRUE(h().stats());

@@ -8,7 +8,7 @@ namespace lsf = lidar_stereo_fusion;
 namespace {
 
 /// The live preset's search (config/live.yaml): two coarse levels of factor 2, pixels without
-/// bounds searched down to 1/2 size, two sweeps at 1/4.
+/// bounds searched down to 1/2 size, two sweeps at 1/4, the 1/2 level only propagating.
 lsf::FusionParams livePreset() {
   lsf::FusionParams f;  // method fused_bi
   lsf::PatchMatchParams& p = f.patchmatch;
@@ -17,6 +17,7 @@ lsf::FusionParams livePreset() {
   p.search_scale = 2;
   p.unbounded_scale = 1;  // config/live.yaml keeps the default: search_scale 2 bounds it
   p.iterations = 2;
+  p.intermediate_refine = false;
   return f;
 }
 
@@ -52,17 +53,18 @@ TEST(RateGovernor, StepsAlternateOneMoreLevelAndACoarserSearchWithoutBounds) {
             "search from 1/8 size, pixels without scan-line bounds searched down to 1/4 size, 2 "
             "sweeps at the coarsest level");
 
-  lsf::FusionParams fusion = livePreset();  // the default preset: every level searches
-  fusion.patchmatch.search_scale = 1;
-  fusion.patchmatch.unbounded_scale = 1;
-  EXPECT_EQ(lsf::effortSteps(fusion).size(), 6u);  // 1, 2, 4, each then one more level
+  lsf::FusionParams propagating = livePreset();  // every level searches, the 1/2 level propagates
+  propagating.patchmatch.search_scale = 1;
+  propagating.patchmatch.unbounded_scale = 1;
+  EXPECT_EQ(lsf::effortSteps(propagating).size(), 6u);  // 1, 2, 4, each then one more level
 
-  lsf::FusionParams deepest = fusion;  // already at the most coarse levels: none is added
+  lsf::FusionParams deepest = propagating;  // already at the most coarse levels: none is added
   deepest.patchmatch.coarse_levels = lsf::PatchMatchParams::kMaxCoarseLevels;
   const auto deep = lsf::effortSteps(deepest);
   ASSERT_EQ(deep.size(), 6u);  // 1, 2, 4, 8, 16, then one sweep
   for (const lsf::EffortStep& s : deep) EXPECT_EQ(s.coarse_levels, 4);
   EXPECT_EQ(deep[4].unbounded_scale, 16);
+  for (const lsf::EffortStep& s : deep) EXPECT_TRUE(s.refine_between);  // nothing to give up
 
   lsf::FusionParams flat;  // no coarse level: nothing to give up
   flat.patchmatch.coarse_levels = 0;
@@ -75,6 +77,49 @@ TEST(RateGovernor, StepsAlternateOneMoreLevelAndACoarserSearchWithoutBounds) {
     other.method = m;
     EXPECT_EQ(lsf::effortSteps(other).size(), 1u) << lsf::methodName(m);
   }
+}
+
+TEST(RateGovernor, ABaseWhoseLevelsBetweenRefineGivesThatUpFirst) {
+  const lsf::FusionParams fusion;  // the default preset: the 1/2 level's right view refines
+  ASSERT_TRUE(fusion.patchmatch.intermediate_refine);
+  const auto steps = lsf::effortSteps(fusion);
+  ASSERT_EQ(steps.size(), 5u);  // as configured, no refinement between, 2, 4, then one more level
+  const int levels[] = {2, 2, 2, 2, 3}, coarsest[] = {4, 4, 4, 4, 8};
+  const int unbounded[] = {1, 1, 2, 4, 4};
+  for (size_t i = 0; i < steps.size(); ++i) {
+    EXPECT_EQ(steps[i].coarse_levels, levels[i]) << i;
+    EXPECT_EQ(steps[i].coarsest_scale, coarsest[i]) << i;
+    EXPECT_EQ(steps[i].unbounded_scale, unbounded[i]) << i;
+    EXPECT_EQ(steps[i].iterations, 2) << i;
+    EXPECT_EQ(steps[i].refine_between, i == 0) << i;
+  }
+  EXPECT_EQ(steps[1].describe(),
+            "search from 1/4 size, pixels without scan-line bounds searched down to full size, 2 "
+            "sweeps at the coarsest level, the right view not refined between the coarsest level "
+            "and full size");
+
+  lsf::RateGovernor g(fusion);
+  EXPECT_TRUE(g.params().patchmatch.intermediate_refine);
+  ASSERT_EQ(feed(g, 10, 0.1, 130.0, 5), 1);
+  EXPECT_EQ(g.step(), 1);
+  const lsf::PatchMatchParams p = g.params().patchmatch;
+  EXPECT_FALSE(p.intermediate_refine);
+  EXPECT_EQ(p.coarse_levels, 2);
+  EXPECT_EQ(p.unbounded_scale, 1);
+  EXPECT_EQ(p.search_scale, 1);  // the rest as configured
+  EXPECT_NO_THROW(p.validate());
+
+  lsf::FusionParams deepest = fusion;  // no level can be added: one sweep last
+  deepest.patchmatch.coarse_levels = lsf::PatchMatchParams::kMaxCoarseLevels;
+  const auto deep = lsf::effortSteps(deepest);
+  ASSERT_EQ(deep.size(), 7u);  // as configured, then 1, 2, 4, 8, 16 without, then one sweep
+  EXPECT_EQ(deep[5].unbounded_scale, 16);
+  EXPECT_EQ(deep[6].iterations, 1);
+  for (const lsf::EffortStep& s : deep) EXPECT_EQ(s.coarse_levels, 4);
+
+  lsf::FusionParams one_level = fusion;  // no level between the coarsest and full size
+  one_level.patchmatch.coarse_levels = 1;
+  for (const lsf::EffortStep& s : lsf::effortSteps(one_level)) EXPECT_TRUE(s.refine_between);
 }
 
 TEST(RateGovernor, KeepsTheSearchWhileNoSetIsDropped) {

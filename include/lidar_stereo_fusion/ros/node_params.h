@@ -94,8 +94,9 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, NodeParams>> visitParams(P&& p,
               {},
               "",
               "When input sets are dropped because the worker is busy, search less, mostly "
-              "above the LiDAR (one more coarse level, pixels without scan-line bounds at a "
-              "coarser level, both) until the frames fit the input's rate again; warned and in "
+              "above the LiDAR (no right-view refinement between levels, one more coarse "
+              "level, pixels without scan-line bounds at a coarser level) until the frames fit "
+              "the input's rate again; warned and in "
               "diagnostics (true in fusion.launch with preset:=live)",
               "",
               kStartup},

@@ -6,7 +6,7 @@
 // Why there: most of PatchMatch's cost evaluations on a KITTI frame go to pixels without
 // scan-line bounds, above the LiDAR's top beam; inside the LiDAR's view the prior leads and the
 // results hardly change (figures: doc/performance.md, "keep_rate"). The steps, each faster than
-// the one before:
+// the one before, where the levels between the coarsest and full size only propagate (`live`):
 //   1. one more coarse level (coarse_levels + 1: `live` starts at 1/8 size instead of 1/4): the
 //      levels it hands to only propagate; the LiDAR's view comes out the same or better (KITTI
 //      ring hold-outs), above the LiDAR coarser;
@@ -18,6 +18,10 @@
 // `live`, KITTI frame 0: 1.00x SGBM (ring hold-out 999 mm, Middlebury lower 2/3 0.343 px), one
 // more level 0.80x (983 mm, 0.431 px), pixels without bounds at 1/4 0.74x (1024 mm, 0.486 px),
 // both 0.58x (994 mm, 0.586 px).
+// Where a level between refines its right view (intermediate_refine, the default preset), the
+// first step gives that up; then pixels without bounds are searched ever coarser, and last one
+// more level is added (or one sweep): the default 2.2x SGBM (synthetic street, error above the
+// LiDAR 0.45 m), 1.8x (0.50 m), 1.5x (0.76 m), 1.3x (1.24 m), 1.1x (2.2 m).
 //
 // ROS-free (test/ros/test_rate_governor.cpp); the worker (fusion_worker.cpp) feeds it once per
 // processed frame and applies params().
@@ -37,8 +41,12 @@ struct EffortStep {
   int coarsest_scale = 1;   ///< their coarsest level's reduction (coarse_scale^coarse_levels)
   int unbounded_scale = 1;  ///< the finest level searching pixels without scan-line bounds
   int iterations = 1;       ///< sweeps of the coarsest level
+  /// false: the levels between the coarsest and the finest only propagate, also where the base
+  /// refines there (PatchMatchParams::intermediate_refine); true: as the base.
+  bool refine_between = true;
   /// E.g. "search from 1/8 size, pixels without scan-line bounds searched down to 1/4 size, 2
-  /// sweeps at the coarsest level".
+  /// sweeps at the coarsest level" (and, where refine_between is false, ", the right view not
+  /// refined between the coarsest level and full size").
   std::string describe() const;
 };
 
@@ -46,10 +54,12 @@ struct EffortStep {
 /// of unbounded_scale and search_scale, u), then the same with one more coarse level (unless
 /// base has PatchMatchParams::kMaxCoarseLevels), then u times coarse_scale with base's levels and
 /// with one more, and so on up to base's coarsest level (coarse_scale^coarse_levels); without the
-/// added level, last one sweep at the coarsest level if base has more. A method that is not fused
-/// (no scan-line bounds to search by) or a base without coarse levels has one step. (A level is
-/// only added where the image is large enough, PatchMatchStereo::compute: on a small image such a
-/// step costs what the one before did.)
+/// added level, last one sweep at the coarsest level if base has more. A base whose levels
+/// between refine (intermediate_refine, coarse_levels >= 2) instead gives that up first, then
+/// takes u times coarse_scale up to its coarsest level, then one more level (or one sweep). A
+/// method that is not fused (no scan-line bounds to search by) or a base without coarse levels
+/// has one step. (A level is only added where the image is large enough,
+/// PatchMatchStereo::compute: on a small image such a step costs what the one before did.)
 std::vector<EffortStep> effortSteps(const FusionParams& base);
 
 class RateGovernor {
