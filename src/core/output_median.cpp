@@ -49,13 +49,6 @@ cv::Mat1f medianOfValues(const cv::Mat1f& disparity, int size) {
   return out;
 }
 
-namespace {
-
-/// A projected point the scan lines still hold with its value (measuredPoints).
-inline bool isMeasured(float sparse, float line) { return sparse > 0.f && sparse == line; }
-
-}  // namespace
-
 cv::Mat1f measuredPoints(const cv::Mat1f& sparse, const cv::Mat1f& lines) {
   if (sparse.size() != lines.size()) {
     throw std::invalid_argument("measuredPoints: the projection and the scan lines differ in size");
@@ -65,7 +58,7 @@ cv::Mat1f measuredPoints(const cv::Mat1f& sparse, const cv::Mat1f& lines) {
     const float* s = sparse[y];
     const float* l = lines[y];
     float* o = out[y];
-    for (int x = 0; x < sparse.cols; ++x) o[x] = isMeasured(s[x], l[x]) ? s[x] : 0.f;
+    for (int x = 0; x < sparse.cols; ++x) o[x] = isMeasuredPoint(s[x], l[x]) ? s[x] : 0.f;
   }
   return out;
 }
@@ -89,7 +82,8 @@ cv::Mat1f medianKeepingMeasured(const cv::Mat1f& disparity, int size, const cv::
     const float* d = disparity[y];
     float* o = out[y];
     for (int x = 0; x < disparity.cols; ++x) {
-      if (isMeasured(s[x], l[x]) && d[x] > 0.f && std::abs(d[x] - s[x]) <= tolerance) o[x] = d[x];
+      if (isMeasuredPoint(s[x], l[x]) && d[x] > 0.f && std::abs(d[x] - s[x]) <= tolerance)
+        o[x] = d[x];
     }
   }
   return out;

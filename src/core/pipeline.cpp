@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "lidar_stereo_fusion/core/both_views.h"
+#include "lidar_stereo_fusion/core/mixed_edges.h"
 #include "lidar_stereo_fusion/core/motion_compensation.h"
 #include "lidar_stereo_fusion/core/output_median.h"
 
@@ -147,7 +148,8 @@ PatchMatchParams FusionParams::plainPmsParams(PatchMatchParams base) {
   base.window_round = false;
   base.median_radius = 17;
   base.output_median = 0;  // not Bleyer's
-  base.iterations = 3;     // Bleyer's
+  base.mixed_edge_fraction = 0.0;
+  base.iterations = 3;  // Bleyer's
   base.right_iterations = -1;
   base.init_from_prior = false;
   base.use_lidar_bounds = false;
@@ -296,6 +298,14 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
       result.disparity = medianKeepingMeasured(
           result.disparity, params_.patchmatch.output_median, left_sparse.disparity,
           left_prior.lines.disparity, static_cast<float>(params_.confidence.edge_tolerance));
+    }
+    if (fused && params_.patchmatch.mixed_edge_fraction > 0.0) {
+      // Boundary pixels that show the nearer surface too take its depth; the LiDAR's points stay.
+      const MixedEdgeParams mixed{static_cast<float>(params_.patchmatch.mixed_edge_fraction),
+                                  static_cast<float>(params_.patchmatch.mixed_edge_contrast)};
+      nearerAtMixedEdges(result.disparity, left_image, left_sparse.disparity,
+                         left_prior.lines.disparity,
+                         static_cast<float>(params_.confidence.edge_tolerance), mixed);
     }
     stats.patchmatch_steps = std::move(matched.steps);
   } else {

@@ -20,6 +20,9 @@ namespace lidar_stereo_fusion {
 /// another size or an empty map.
 cv::Mat1f medianOfValues(const cv::Mat1f& disparity, int size);
 
+/// Whether a projected point (`sparse`, > 0) is still on the scan lines (`lines`) with its value.
+inline bool isMeasuredPoint(float sparse, float line) { return sparse > 0.f && sparse == line; }
+
 /// The LiDAR points a median must not move: `sparse` (the projection, nearest point per pixel)
 /// where the scan lines after Algorithm 1 (`lines`) still hold that very value (Algorithm 1 did
 /// not remove it as occluded, no nearer line crosses the pixel), else 0. Throws

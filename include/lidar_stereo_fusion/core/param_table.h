@@ -189,6 +189,13 @@ std::enable_if_t<std::is_same_v<std::decay_t<P>, PatchMatchParams>> visitParams(
               "Median of the fused output over this square (3 or 5; 0 = none): removes "
               "speckles, and with 5 lines under 3 px wide; LiDAR points stay"},
     p.output_median);
+  v(ParamSpec{"mixed_edge_fraction", g, within(0, 1), "",
+              "After the median: an edge pixel whose colour mixes in this fraction of a nearer "
+              "neighbour's takes its depth (0 = off)"},
+    p.mixed_edge_fraction);
+  v(ParamSpec{"mixed_edge_contrast", g, atLeast(0), "",
+              "Mixed edge pixels: smallest RGB L1 difference of the two surfaces' colours"},
+    p.mixed_edge_contrast);
   v(ParamSpec{"confidence_weighting",
               g,
               {},

@@ -80,6 +80,11 @@ struct PatchMatchParams {
   int median_radius = 5;
   /// Median of the fused output over size x size pixels (3 or 5; 0 = none): output_median.h.
   int output_median = 3;
+  /// After the median, edge pixels whose colour mixes in at least this fraction of a nearer
+  /// neighbour's take its disparity (0 = off): mixed_edges.h.
+  double mixed_edge_fraction = 0.75;
+  /// Smallest RGB L1 contrast between the two surfaces for that [0..765].
+  double mixed_edge_contrast = 60.0;
   /// Weight the LiDAR term by the prior's confidence and renormalise the image term where it fades
   /// (patchmatch/cost.h); false = the paper's cost (gamma everywhere the prior has a value).
   bool confidence_weighting = true;

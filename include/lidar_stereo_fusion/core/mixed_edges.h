@@ -1,0 +1,45 @@
+// Stage 3, after the output median (not in the paper): pixels that mix a nearer surface's colour
+// into a farther one's at a depth edge take the nearer depth.
+//
+// A pixel on the boundary of a foreground object sees both surfaces: its colour lies between
+// theirs. The matcher gives such pixels the background's plane more often than not (their support
+// windows hold more background than foreground; on the synthetic street, where the depth is exact,
+// 3 of 4 boundary pixels whose colour holds more than a third of the foreground's are foreground at
+// their centre). A depth reference made of LiDAR returns counts them as foreground too (the
+// nearest return of a pixel wins, and a beam's footprint spans the boundary), and so does a
+// planner that has to keep clear of them. So a pixel p beside a nearer neighbour q (4-neighbours,
+// depth ratio >= kMixedEdgeMinRatio) whose colour, on the line from the colour of the pixel p' on
+// its far side (same surface as p: within kMixedEdgeSameSurface) to q's colour, lies at least
+// `min_fraction` of the way to q's, takes q's disparity. Measured on every protocol:
+// doc/accuracy.md (mixed edge pixels).
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace lidar_stereo_fusion {
+
+/// q's depth at most this fraction of p's (disparity ratio d_q / d_p >= this): a depth edge, not a
+/// slanted surface (a road 1 px apart differs by under 1 %); 1.15-1.6 give the same results.
+constexpr float kMixedEdgeMinRatio = 1.3f;
+/// p' continues p's surface: its disparity at most this factor above p's.
+constexpr float kMixedEdgeSameSurface = 1.1f;
+
+struct MixedEdgeParams {
+  /// How far p's colour lies from p' to q's colour (0..1) for p to take q's disparity (0 = off).
+  float min_fraction = 0.75f;
+  /// Smallest RGB L1 difference between p' and q (grey images: 3 |a - b|): below it the colours
+  /// cannot tell the surfaces apart.
+  float min_contrast = 60.f;
+};
+
+/// Sets every mixed edge pixel of `disparity` to its nearest qualifying neighbour's disparity,
+/// decided on the input (the result does not depend on the scan order), and returns how many it
+/// set. Empty pixels, the image border's pixels and the LiDAR's points that the disparity agrees
+/// with within `tolerance` [px] (isMeasuredPoint(sparse, lines), as medianKeepingMeasured keeps
+/// them; `sparse` and `lines` may both be empty: none) stay. `image` is 8-bit BGR or grey of the
+/// disparity's size. Throws std::invalid_argument for sizes or types that differ, or parameters
+/// out of range (fraction in [0, 1], contrast >= 0, tolerance >= 0, all finite).
+int nearerAtMixedEdges(cv::Mat1f& disparity, const cv::Mat& image, const cv::Mat1f& sparse,
+                       const cv::Mat1f& lines, float tolerance, const MixedEdgeParams& params);
+
+}  // namespace lidar_stereo_fusion
