@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "lidar_stereo_fusion/core/output_median.h"
+#include "lidar_stereo_fusion/core/patchmatch/parallel.h"
 
 namespace lidar_stereo_fusion {
 
@@ -42,6 +43,9 @@ bool mixesIn(const cv::Mat& image, int y, int x, int dy, int dx, const MixedEdge
   return contrast > 0.f && contrast >= params.min_contrast && along >= params.min_fraction * length;
 }
 
+/// The 4-neighbours q = p + step (p' = p - step).
+constexpr int kSteps[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+
 struct Change {
   int y, x;
   float disparity;
@@ -50,7 +54,8 @@ struct Change {
 }  // namespace
 
 int nearerAtMixedEdges(cv::Mat1f& disparity, const cv::Mat& image, const cv::Mat1f& sparse,
-                       const cv::Mat1f& lines, float tolerance, const MixedEdgeParams& params) {
+                       const cv::Mat1f& lines, float tolerance, const MixedEdgeParams& params,
+                       int threads) {
   if (image.size() != disparity.size() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) {
     throw std::invalid_argument(
         "nearerAtMixedEdges: the image must be 8-bit BGR or grey of the disparity's size");
@@ -67,50 +72,62 @@ int nearerAtMixedEdges(cv::Mat1f& disparity, const cv::Mat& image, const cv::Mat
         "nearerAtMixedEdges: min_fraction must lie in [0, 1], min_contrast and the tolerance "
         "must be finite and >= 0");
   }
-  std::vector<Change> changes;
-  std::vector<uchar> flags(static_cast<size_t>(disparity.cols) + 8, 0);
-  static constexpr int kSteps[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
-  for (int y = 1; y + 1 < disparity.rows; ++y) {
-    const float* __restrict above = disparity[y - 1];
-    const float* __restrict row = disparity[y];
-    const float* __restrict below = disparity[y + 1];
-    uchar* __restrict flag = flags.data();
-    // A pass the compiler vectorises flags the pixels with a much nearer 4-neighbour (a few per
-    // cent of an image); the scan below skips 8 unflagged pixels at a time.
-    for (int x = 1; x + 1 < disparity.cols; ++x) {
-      const float nearest =
-          std::max(std::max(above[x], below[x]), std::max(row[x - 1], row[x + 1]));
-      flag[x] = static_cast<uchar>((row[x] > 0.f) & (nearest >= kMixedEdgeMinRatio * row[x]));
-    }
-    for (int x = 1; x + 1 < disparity.cols; ++x) {
-      if ((x & 7) == 0) {
-        uint64_t block;
-        std::memcpy(&block, flag + x, sizeof block);
-        if (block == 0) {
-          x += 7;
-          continue;
+  // Fixed strips of rows, each with its own list of changes, applied after every strip has
+  // decided on the input: the result does not depend on the thread count.
+  const int rows = disparity.rows - 2;
+  const int strips = rows <= 0 ? 0 : std::min(rows, threads <= 1 ? 1 : 4 * threads);
+  std::vector<std::vector<Change>> strip_changes(static_cast<size_t>(std::max(0, strips)));
+  patchmatch::parallelFor(strips, threads, [&](int strip) {
+    std::vector<Change>& changes = strip_changes[static_cast<size_t>(strip)];
+    std::vector<uchar> flags(static_cast<size_t>(disparity.cols) + 8, 0);
+    const int y_begin = 1 + static_cast<int>(static_cast<int64_t>(rows) * strip / strips);
+    const int y_end = 1 + static_cast<int>(static_cast<int64_t>(rows) * (strip + 1) / strips);
+    for (int y = y_begin; y < y_end; ++y) {
+      const float* __restrict above = disparity[y - 1];
+      const float* __restrict row = disparity[y];
+      const float* __restrict below = disparity[y + 1];
+      uchar* __restrict flag = flags.data();
+      // A pass the compiler vectorises flags the pixels with a much nearer 4-neighbour (a few per
+      // cent of an image); the scan below skips 8 unflagged pixels at a time.
+      for (int x = 1; x + 1 < disparity.cols; ++x) {
+        const float nearest =
+            std::max(std::max(above[x], below[x]), std::max(row[x - 1], row[x + 1]));
+        flag[x] = static_cast<uchar>((row[x] > 0.f) & (nearest >= kMixedEdgeMinRatio * row[x]));
+      }
+      for (int x = 1; x + 1 < disparity.cols; ++x) {
+        if ((x & 7) == 0) {
+          uint64_t block;
+          std::memcpy(&block, flag + x, sizeof block);
+          if (block == 0) {
+            x += 7;
+            continue;
+          }
         }
-      }
-      if (!flag[x]) continue;
-      const float d = disparity(y, x);
-      if (!sparse.empty() && isMeasuredPoint(sparse(y, x), lines(y, x)) &&
-          std::abs(d - sparse(y, x)) <= tolerance) {
-        continue;  // a LiDAR point the output agrees with
-      }
-      float nearer = d;
-      for (const auto& step : kSteps) {
-        const float dq = disparity(y + step[0], x + step[1]);
-        const float df = disparity(y - step[0], x - step[1]);
-        if (dq > nearer && dq >= kMixedEdgeMinRatio * d && df > 0.f &&
-            df <= kMixedEdgeSameSurface * d && mixesIn(image, y, x, step[0], step[1], params)) {
-          nearer = dq;
+        if (!flag[x]) continue;
+        const float d = disparity(y, x);
+        if (!sparse.empty() && isMeasuredPoint(sparse(y, x), lines(y, x)) &&
+            std::abs(d - sparse(y, x)) <= tolerance) {
+          continue;  // a LiDAR point the output agrees with
         }
+        float nearer = d;
+        for (const auto& step : kSteps) {
+          const float dq = disparity(y + step[0], x + step[1]);
+          const float df = disparity(y - step[0], x - step[1]);
+          if (dq > nearer && dq >= kMixedEdgeMinRatio * d && df > 0.f &&
+              df <= kMixedEdgeSameSurface * d && mixesIn(image, y, x, step[0], step[1], params)) {
+            nearer = dq;
+          }
+        }
+        if (nearer > d) changes.push_back({y, x, nearer});
       }
-      if (nearer > d) changes.push_back({y, x, nearer});
     }
+  });
+  int count = 0;
+  for (const auto& changes : strip_changes) {
+    for (const Change& c : changes) disparity(c.y, c.x) = c.disparity;
+    count += static_cast<int>(changes.size());
   }
-  for (const Change& c : changes) disparity(c.y, c.x) = c.disparity;
-  return static_cast<int>(changes.size());
+  return count;
 }
 
 }  // namespace lidar_stereo_fusion

@@ -10,6 +10,7 @@
 #include "lidar_stereo_fusion/core/mixed_edges.h"
 #include "lidar_stereo_fusion/core/motion_compensation.h"
 #include "lidar_stereo_fusion/core/output_median.h"
+#include "lidar_stereo_fusion/core/patchmatch/propagation.h"
 
 #include "scan_line_columns.h"
 
@@ -305,7 +306,8 @@ FusionResult FusionPipeline::runStages(const cv::Mat& left_image, const cv::Mat&
                                   static_cast<float>(params_.patchmatch.mixed_edge_contrast)};
       nearerAtMixedEdges(result.disparity, left_image, left_sparse.disparity,
                          left_prior.lines.disparity,
-                         static_cast<float>(params_.confidence.edge_tolerance), mixed);
+                         static_cast<float>(params_.confidence.edge_tolerance), mixed,
+                         patchmatch::threadCount(params_.patchmatch));
     }
     stats.patchmatch_steps = std::move(matched.steps);
   } else {

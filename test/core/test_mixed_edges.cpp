@@ -122,6 +122,27 @@ TEST(MixedEdges, EveryDirection) {
   }
 }
 
+TEST(MixedEdges, TheSameForAnyThreadCount) {
+  // Random blocks of two depths and random colours: many candidates in every strip of rows.
+  cv::RNG rng(7);
+  cv::Mat1f disparity(61, 47);
+  cv::Mat3b image(61, 47);
+  for (int y = 0; y < disparity.rows; ++y) {
+    for (int x = 0; x < disparity.cols; ++x) {
+      disparity(y, x) = ((x / 3 + y / 4) % 2) ? kNear : kFar;
+      image(y, x) = cv::Vec3b(rng.uniform(0, 256), rng.uniform(0, 256), rng.uniform(0, 256));
+    }
+  }
+  cv::Mat1f one = disparity.clone();
+  const int changed = nearerAtMixedEdges(one, image, {}, {}, 0.5f, {}, 1);
+  EXPECT_GT(changed, 20);
+  for (int threads : {2, 3, 8}) {
+    cv::Mat1f many = disparity.clone();
+    EXPECT_EQ(nearerAtMixedEdges(many, image, {}, {}, 0.5f, {}, threads), changed) << threads;
+    EXPECT_EQ(cv::countNonZero(many != one), 0) << threads;
+  }
+}
+
 TEST(MixedEdges, GreyImagesCountThreeTimesTheDifference) {
   Scene colour(40);
   cv::Mat1b grey;

@@ -37,9 +37,11 @@ struct MixedEdgeParams {
 /// set. Empty pixels, the image border's pixels and the LiDAR's points that the disparity agrees
 /// with within `tolerance` [px] (isMeasuredPoint(sparse, lines), as medianKeepingMeasured keeps
 /// them; `sparse` and `lines` may both be empty: none) stay. `image` is 8-bit BGR or grey of the
-/// disparity's size. Throws std::invalid_argument for sizes or types that differ, or parameters
-/// out of range (fraction in [0, 1], contrast >= 0, tolerance >= 0, all finite).
+/// disparity's size. `threads`: strips of rows on the core's pool (patchmatch/parallel.h), the
+/// same result for any count. Throws std::invalid_argument for sizes or types that differ, or
+/// parameters out of range (fraction in [0, 1], contrast >= 0, tolerance >= 0, all finite).
 int nearerAtMixedEdges(cv::Mat1f& disparity, const cv::Mat& image, const cv::Mat1f& sparse,
-                       const cv::Mat1f& lines, float tolerance, const MixedEdgeParams& params);
+                       const cv::Mat1f& lines, float tolerance, const MixedEdgeParams& params,
+                       int threads = 1);
 
 }  // namespace lidar_stereo_fusion
