@@ -76,12 +76,16 @@ Options:
                         for a cloud without a ring field: shuffled, image-rows, or
                         image-rows-cropped (only the points in view, as a depth-completion
                         dataset gives them); the references are unchanged
+  --save-dir <dir>      write every scored case there (created if missing): each method's output
+                        before the devkit fill, the reference and the left image, as
+                        <layout>_<item>_<method>.tiff (32-bit float: Middlebury disparity [px],
+                        else depth [m]), <layout>_<item>_reference.tiff, <layout>_<item>_left.png
   --help                this text
 )";
 
 struct Options {
   std::string data, params, ip_basic_blur = "gaussian", reference = "nearest",
-                            sweep_order = "recorded";
+                            sweep_order = "recorded", save_dir;
   double stereo_check_px = 0.0;
   std::set<std::string> methods, layouts;
   bool middlebury = true, kitti = true, dense = true, synthetic = true, kitti_pms = true;
@@ -115,7 +119,7 @@ Options parseOptions(int argc, char** argv) {
   const lsf::CommandLine cl(
       argc, argv,
       {"--data", "--protocols", "--layouts", "--frames", "--params", "--methods", "--ip-basic-blur",
-       "--reference", "--stereo-check", "--sweep-order"},
+       "--reference", "--stereo-check", "--sweep-order", "--save-dir"},
       {"--no-kitti-pms", "--keep-unverified"});
   Options o;
   o.data = cl.value("--data", defaultDataDir());
@@ -123,6 +127,8 @@ Options parseOptions(int argc, char** argv) {
   o.kitti_pms = !cl.has("--no-kitti-pms");
   o.keep_unverified = cl.has("--keep-unverified");
   o.params = cl.value("--params", "");
+  o.save_dir = cl.value("--save-dir", "");
+  if (cl.has("--save-dir") && o.save_dir.empty()) throw lsf::UsageError("--save-dir: empty folder");
   o.ip_basic_blur = cl.choice("--ip-basic-blur", "gaussian", {"gaussian", "bilateral", "none"});
   o.reference = cl.choice("--reference", "nearest", {"nearest", "majority"});
   o.sweep_order = cl.choice("--sweep-order", "recorded", lsf::sweepOrderNames());
@@ -194,6 +200,15 @@ lsf::AccuracyOptions accuracyOptions(const Options& o) {
   options.kitti_pms = o.kitti_pms;
   options.sweep_order = lsf::parseSweepOrder(o.sweep_order);
   options.progress = &std::cerr;
+  options.save_dir = o.save_dir;
+  if (!o.save_dir.empty()) {  // before any protocol runs, not after the first case
+    std::error_code error;
+    std::filesystem::create_directories(o.save_dir, error);
+    if (error || !std::filesystem::is_directory(o.save_dir)) {
+      throw std::runtime_error("--save-dir: cannot create the folder " + o.save_dir +
+                               (error ? ": " + error.message() : std::string()));
+    }
+  }
   options.methods = o.methods;
   options.layouts = o.layouts;
   options.ip_basic.blur = o.ip_basic_blur == "bilateral" ? lsf::IpBasicBlur::kBilateral

@@ -1,8 +1,13 @@
 // Scoring, rows and one KITTI case of the accuracy protocols.
 #include "accuracy_common.h"
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <set>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
 
 #include "lidar_stereo_fusion/core/depth.h"
 
@@ -26,6 +31,43 @@ const char* const kIpBasic = "ip_basic";
 
 double secondsSince(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+namespace {
+
+/// Writes `image` to `path` (OpenCV's TIFF writer keeps 32-bit floats exactly).
+void writeImage(const std::filesystem::path& path, const cv::Mat& image) {
+  bool written = false;
+  try {
+    written = cv::imwrite(path.string(), image);
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error("save_dir: cannot write " + path.string() + ": " + e.what());
+  }
+  if (!written) throw std::runtime_error("save_dir: cannot write " + path.string());
+}
+
+}  // namespace
+
+void saveCase(const AccuracyOptions& options, const std::string& layout, const std::string& item,
+              const std::vector<std::pair<std::string, cv::Mat1f>>& outputs,
+              const cv::Mat1f& reference, const cv::Mat& left) {
+  if (options.save_dir.empty()) return;
+  const std::filesystem::path dir(options.save_dir);
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) {
+    throw std::runtime_error("save_dir: cannot create " + dir.string() + ": " + error.message());
+  }
+  std::string name = item;
+  std::replace(name.begin(), name.end(), ' ', '-');
+  const std::string stem = layout + "_" + name + "_";
+  for (const auto& [method, map] : outputs) {
+    std::string file = method;
+    std::replace(file.begin(), file.end(), ' ', '_');  // "lidar_bi else pms"
+    writeImage(dir / (stem + file + ".tiff"), map);
+  }
+  writeImage(dir / (stem + "reference.tiff"), reference);
+  writeImage(dir / (stem + "left.png"), left);
 }
 
 double rawCoverage(const cv::Mat1f& estimate, const cv::Mat1f& reference) {
@@ -93,7 +135,7 @@ std::vector<std::pair<std::string, FusionParams>> pipelineRows(const AccuracyOpt
 void scoreDepthCase(const DepthCase& c, const AccuracyOptions& options,
                     const std::vector<std::pair<std::string, FusionParams>>& rows, PmsRun& pms,
                     LayoutAccumulator<DepthMetrics>& acc) {
-  scoreDepthCaseAgainst(c, {{c.reference, acc}}, options, rows, pms);
+  scoreDepthCaseAgainst(c, {{c.reference, acc, c.layout}}, options, rows, pms);
 }
 
 void scoreDepthCaseAgainst(const DepthCase& c, const std::vector<DepthTarget>& targets,
@@ -134,7 +176,12 @@ void scoreDepthCaseAgainst(const DepthCase& c, const std::vector<DepthTarget>& t
     runs.push_back({kIpBasic, {filled, secondsSince(t)}});
   }
   const RegionMasks fed_masks = computeRegionMasks(fed, c.frame.left);
+  std::vector<std::pair<std::string, cv::Mat1f>> outputs;
+  if (!options.save_dir.empty()) {
+    for (const auto& [name, run] : runs) outputs.push_back({name, run.first});
+  }
   for (const DepthTarget& target : targets) {
+    saveCase(options, target.layout, c.item, outputs, target.reference, c.frame.left);
     RegionMasks masks = fed_masks;
     masks.setDepthBands(target.reference);
     masks.setInBothViews(depthToDisparity(target.reference, camera));

@@ -38,6 +38,12 @@ RegionScores<DepthMetrics> scoreRegions(const cv::Mat1f& depth, const cv::Mat1f&
 cv::Mat1f ipBasicOnDisparity(const cv::Mat1f& disparity, const StereoCamera& camera,
                              const IpBasicParams& params);
 
+/// options.save_dir's files of one case (AccuracyOptions::save_dir); nothing when it is empty.
+/// `item` with spaces turned into '-'. Throws std::runtime_error naming a file it cannot write.
+void saveCase(const AccuracyOptions& options, const std::string& layout, const std::string& item,
+              const std::vector<std::pair<std::string, cv::Mat1f>>& outputs,
+              const cv::Mat1f& reference, const cv::Mat& left);
+
 bool wantedRow(const AccuracyOptions& options, const std::string& name);
 bool wantedLayout(const AccuracyOptions& options, const std::string& name);
 
@@ -100,6 +106,7 @@ struct DepthCase {
   const LidarCloud& fed;
   const cv::Mat1f& reference;  ///< [m], 0 = no reference
   const kitti::Calibration& calib;
+  std::string layout = {}, item = {};  ///< saveCase's names (scoreDepthCase's one target)
 };
 
 /// The pms result of a frame, shared by its layouts (pms uses no LiDAR).
@@ -120,6 +127,7 @@ void scoreDepthCase(const DepthCase& c, const AccuracyOptions& options,
 struct DepthTarget {
   const cv::Mat1f& reference;
   LayoutAccumulator<DepthMetrics>& acc;
+  std::string layout = {};  ///< saveCase's name of the layout
 };
 
 /// scoreDepthCase against several references of the same frame and fed cloud: every row runs

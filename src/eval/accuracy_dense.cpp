@@ -48,7 +48,7 @@ DenseProtocolResult runDenseProtocol(const AccuracyOptions& options,
   layout.fed_rings.push_back(fed.rings);
   LayoutAccumulator<DepthMetrics> acc;
   PmsRun pms;
-  scoreDepthCase({data, fed.cloud, out.reference.depth, calib}, options,
+  scoreDepthCase({data, fed.cloud, out.reference.depth, calib, layout.name, frame->name}, options,
                  pipelineRows(options, options.kitti_pms), pms, acc);
   layout.methods = acc.finish();
   const long center = static_cast<long>(kitti::frameIndex(kDenseFrame));

@@ -82,9 +82,11 @@ void scoreMiddleburyLayout(const MiddleburyScene& scene, const std::string& scen
       if (cv::countNonZero(left_sparse.disparity.row(y)) > 0) layout.fed_rows.push_back(y);
     }
   }
+  std::vector<std::pair<std::string, cv::Mat1f>> saved;  // saveCase's outputs
   const auto add = [&](const std::string& name, const cv::Mat1f& disparity, double seconds) {
     acc.add(name, scoreRegions(disparity, scene.disparity, masks),
             rawCoverage(disparity, scene.disparity), seconds);
+    if (!options.save_dir.empty()) saved.push_back({name, disparity});
   };
   std::map<std::string, cv::Mat1f> results;
   for (const auto& [name, params] : rows) {
@@ -114,6 +116,7 @@ void scoreMiddleburyLayout(const MiddleburyScene& scene, const std::string& scen
     const cv::Mat1f filled = ipBasicOnDisparity(left_sparse.disparity, camera, options.ip_basic);
     add(kIpBasic, filled, secondsSince(t));
   }
+  saveCase(options, layout.name, scene_name, saved, scene.disparity, scene.left);
 }
 
 }  // namespace
@@ -243,8 +246,8 @@ std::vector<LayoutScores<DepthMetrics>> runKittiProtocol(const AccuracyOptions& 
       const FedSweep fed = fedSweep(holdout.fed, options, calib);
       out[li].fed_rings.push_back(fed.rings);
       if (!fed.note.empty()) notes[li] = fed.note;
-      scoreDepthCase({data, fed.cloud, holdout.reference_depth, calib}, options, rows, pms,
-                     acc[li]);
+      scoreDepthCase({data, fed.cloud, holdout.reference_depth, calib, out[li].name, frame.name},
+                     options, rows, pms, acc[li]);
     }
   }
   for (size_t li = 0; li < out.size(); ++li) {

@@ -92,12 +92,13 @@ std::vector<LayoutScores<DepthMetrics>> runSyntheticDenseProtocol(
       targets.push_back({name == "syn_exact"   ? exact
                          : name == "syn_lidar" ? lidar_made
                                                : f.depth,
-                         acc[i]});
+                         acc[i], name});
       out[i].items.push_back("seed " + std::to_string(seed));
       out[i].fed_rings.push_back(rings);
     }
     PmsRun pms;
-    scoreDepthCaseAgainst({frame, frame.cloud, exact, calib}, targets, options, rows, pms);
+    scoreDepthCaseAgainst({frame, frame.cloud, exact, calib, "", "seed " + std::to_string(seed)},
+                          targets, options, rows, pms);
   }
   const std::string what =
       "the synthetic street (seeds " + std::to_string(params.seeds.front()) +

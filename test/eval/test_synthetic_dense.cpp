@@ -1,11 +1,17 @@
 // The synthetic dense protocol (eval/synthetic_dense.h): the LiDAR-made reference, exactly, on
 // hand-made scenes; the protocol's layouts on the synthetic street.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
 #include <stdexcept>
+#include <string>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "lidar_stereo_fusion/core/metrics.h"
 #include "lidar_stereo_fusion/eval/synthetic_dense.h"
 #include "lidar_stereo_fusion/sim/scene.h"
 #include "sim/small_sim_params.h"
@@ -154,4 +160,49 @@ TEST(SyntheticDenseProtocol, ScoresTheSameOutputsAtTheSamePixelsAgainstBothRefer
   EXPECT_GT(image_fused->mean[0].mae_mm, e.mae_mm);
   options.layouts = {"syn_lidar"};
   EXPECT_EQ(lsf::runSyntheticDenseProtocol(options, params).size(), 1u);
+}
+
+// AccuracyOptions::save_dir: every scored case's outputs, reference and left image are written,
+// and the saved output scored against the saved reference (devkit fill, as the protocol scores)
+// gives the protocol's very figures: the files are what was scored.
+TEST(SyntheticDenseProtocol, SavesWhatItScores) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("lsf_save_dir_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  lsf::AccuracyOptions options;
+  options.methods = {"fused", "ip_basic"};
+  options.layouts = {"syn_exact"};
+  options.kitti_pms = false;
+  options.save_dir = (dir / "new").string();  // created
+  lsf::SyntheticDenseParams params;
+  params.seeds = {1};
+  const auto layouts = lsf::runSyntheticDenseProtocol(options, params);
+  ASSERT_EQ(layouts.size(), 1u);
+  const std::string stem = (dir / "new" / "syn_exact_seed-1_").string();
+  const cv::Mat reference = cv::imread(stem + "reference.tiff", cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(reference.type(), CV_32FC1);
+  EXPECT_FALSE(cv::imread(stem + "left.png").empty());
+  for (const std::string method : {"fused", "ip_basic"}) {
+    const cv::Mat output = cv::imread(stem + method + ".tiff", cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(output.type(), CV_32FC1) << method;
+    const auto* row = layouts[0].find(method);
+    ASSERT_TRUE(row) << method;
+    const sim::SyntheticParams p;
+    const lsf::StereoCamera camera{p.fx, p.fy, p.cx, p.cy, p.baseline, p.width, p.height};
+    const lsf::DepthMetrics m =
+        lsf::evaluateDepth(lsf::fillLikeDevkit(output, lsf::MapKind::kDepth), reference, camera);
+    EXPECT_EQ(m.count, row->mean[0].count) << method;
+    EXPECT_NEAR(m.mae_mm, row->mean[0].mae_mm, 1e-6 * row->mean[0].mae_mm) << method;
+  }
+  EXPECT_FALSE(fs::exists(stem + "paper.tiff"));  // only the rows that ran
+  // A folder that cannot be made: the error names it.
+  std::ofstream(dir / "file") << "x";
+  options.save_dir = (dir / "file" / "sub").string();
+  try {
+    lsf::runSyntheticDenseProtocol(options, params);
+    ADD_FAILURE() << "no error for " << options.save_dir;
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(options.save_dir), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
 }

@@ -1,8 +1,10 @@
 // accuracy_report's command line: an option that only a protocol left out would read is refused
-// with a message naming it (exit 2, before any data is read), never ignored.
+// with a message naming it (exit 2, before any data is read), never ignored; a --save-dir that
+// cannot be made stops the run before any protocol (exit 1).
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -51,6 +53,19 @@ TEST(AccuracyReportOptions, AnUnknownSweepOrderIsNamedWithTheValidOnes) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_NE(r.err.find("'sorted'"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("image-rows-cropped"), std::string::npos) << r.err;
+}
+
+TEST(AccuracyReportOptions, ASaveDirThatCannotBeMadeStopsBeforeAnyProtocol) {
+  namespace fs = std::filesystem;
+  const fs::path file =
+      fs::temp_directory_path() / ("lsf_accuracy_report_file_" + std::to_string(::getpid()));
+  std::ofstream(file) << "x";
+  const std::string dir = (file / "sub").string();
+  const lsf::test::RunResult r = accuracyReport("--protocols synthetic --save-dir " + dir);
+  fs::remove(file);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("--save-dir: cannot create the folder " + dir), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
 }
 
 }  // namespace

@@ -165,6 +165,12 @@ struct AccuracyOptions {
   /// recorded rings, and the reference is unchanged).
   SweepOrder sweep_order = SweepOrder::kRecorded;
   std::ostream* progress = nullptr;  ///< one line per scene / frame when set
+  /// When set, every scored case is written there (the folder is created): each method's output
+  /// as run, before the devkit fill (<layout>_<item>_<method>.tiff, 32-bit float: disparity [px]
+  /// on Middlebury, depth [m] elsewhere), the reference (<layout>_<item>_reference.tiff) and the
+  /// left image (<layout>_<item>_left.png); <item> is the scene, the KITTI frame or "seed-N".
+  /// A file that cannot be written throws std::runtime_error naming it.
+  std::string save_dir;
   /// Throws std::invalid_argument for an unknown method / layout name or kitti_frames < 0.
   void validate() const;
 };
