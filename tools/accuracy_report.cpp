@@ -9,6 +9,7 @@
 #include <iostream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -202,11 +203,10 @@ lsf::AccuracyOptions accuracyOptions(const Options& o) {
   options.progress = &std::cerr;
   options.save_dir = o.save_dir;
   if (!o.save_dir.empty()) {  // before any protocol runs, not after the first case
-    std::error_code error;
-    std::filesystem::create_directories(o.save_dir, error);
-    if (error || !std::filesystem::is_directory(o.save_dir)) {
-      throw std::runtime_error("--save-dir: cannot create the folder " + o.save_dir +
-                               (error ? ": " + error.message() : std::string()));
+    try {
+      lsf::createSaveDir(o.save_dir);
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(std::string("--save-dir: ") + e.what());
     }
   }
   options.methods = o.methods;

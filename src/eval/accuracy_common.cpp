@@ -48,16 +48,25 @@ void writeImage(const std::filesystem::path& path, const cv::Mat& image) {
 
 }  // namespace
 
+}  // namespace accuracy_detail
+
+void createSaveDir(const std::string& dir) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error || !std::filesystem::is_directory(dir)) {
+    throw std::runtime_error("cannot create the folder " + dir +
+                             (error ? ": " + error.message() : std::string()));
+  }
+}
+
+namespace accuracy_detail {
+
 void saveCase(const AccuracyOptions& options, const std::string& layout, const std::string& item,
               const std::vector<std::pair<std::string, cv::Mat1f>>& outputs,
               const cv::Mat1f& reference, const cv::Mat& left) {
   if (options.save_dir.empty()) return;
+  createSaveDir(options.save_dir);
   const std::filesystem::path dir(options.save_dir);
-  std::error_code error;
-  std::filesystem::create_directories(dir, error);
-  if (error) {
-    throw std::runtime_error("save_dir: cannot create " + dir.string() + ": " + error.message());
-  }
   std::string name = item;
   std::replace(name.begin(), name.end(), ' ', '-');
   const std::string stem = layout + "_" + name + "_";

@@ -175,6 +175,10 @@ struct AccuracyOptions {
   void validate() const;
 };
 
+/// Creates `dir` (AccuracyOptions::save_dir) with its parents, or finds it there; throws
+/// std::runtime_error "cannot create the folder <dir>: <reason>" where it cannot.
+void createSaveDir(const std::string& dir);
+
 /// The method row names in table order, and the layout names of each protocol.
 std::vector<std::string> accuracyMethodNames();
 std::vector<std::string> middleburyLayoutNames();
