@@ -32,8 +32,9 @@ Runs every method (fused = FusionParams() defaults, paper = config/paper.yaml, l
 pms, "lidar_bi else pms", nearest, ip_basic) on the accuracy protocols and prints Markdown tables:
 one per layout (rows = methods, columns = metrics, mean over scenes / frames), then the
 per-region tables (above the LiDAR, inside, depth edge, elsewhere inside) and, on KITTI, the
-depth bands (< 10 m, 10-30 m, >= 30 m of the reference depth). Empty pixels are filled like the
-KITTI devkit (interpolateBackground) before scoring.
+depth bands (< 10 m, 10-30 m, >= 30 m of the reference depth), and which surface the reference
+has at each method's own depth edges (eval/edge_sides.h). Empty pixels are filled like the KITTI
+devkit (interpolateBackground) before scoring.
 
   middlebury: cones + teddy: mb64 (64 ground-truth rows), mb16 (16 rows), mb42low (42 rows over
     the lower 2/3); errors in disparity px over every ground-truth pixel.
@@ -228,12 +229,19 @@ lsf::AccuracyOptions accuracyOptions(const Options& o) {
   return options;
 }
 
+/// Heads each layout's edge-sides table (eval/edge_sides.h).
+const char* const kEdgeSidesTitle =
+    "At each method's own depth edges (a pixel whose nearest 4-neighbour is >= 1.3x nearer), the "
+    "reference has the near surface, the pixel's own far one (within 10 %), a depth between or "
+    "another (summed over the items):\n\n";
+
 void printMiddlebury(const lsf::AccuracyOptions& options) {
   const auto t = std::chrono::steady_clock::now();
   for (const auto& layout : lsf::runMiddleburyProtocol(options)) {
     std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
               << lsf::formatMiddleburyLayout(layout) << "\nPer region (mean of scenes):\n\n"
-              << lsf::formatMiddleburyRegions(layout) << "\n";
+              << lsf::formatMiddleburyRegions(layout) << "\n"
+              << kEdgeSidesTitle << lsf::formatEdgeSides(layout) << "\n";
   }
   std::cout << "Middlebury protocol: " << secondsSince(t) << " s\n\n";
 }
@@ -246,7 +254,8 @@ void printDepthLayouts(const std::vector<lsf::LayoutScores<lsf::DepthMetrics>>& 
     std::cout << "## " << layout.name << ": " << layout.description << "\n\n"
               << lsf::formatKittiLayout(layout) << "\nPer depth band (mean of " << items << "):\n\n"
               << lsf::formatDepthBands(layout) << "\nPer region (mean of " << items << "):\n\n"
-              << lsf::formatKittiRegions(layout) << "\n";
+              << lsf::formatKittiRegions(layout) << "\n"
+              << kEdgeSidesTitle << lsf::formatEdgeSides(layout) << "\n";
   }
 }
 
@@ -270,7 +279,8 @@ void printDense(const lsf::AccuracyOptions& options, const Options& o) {
             << lsf::formatKittiLayout(dense.layout)
             << "\nPer depth band of the reference depth:\n\n"
             << lsf::formatDepthBands(dense.layout) << "\nPer region:\n\n"
-            << lsf::formatKittiRegions(dense.layout) << "\nThe reference:\n\n"
+            << lsf::formatKittiRegions(dense.layout) << "\n"
+            << kEdgeSidesTitle << lsf::formatEdgeSides(dense.layout) << "\nThe reference:\n\n"
             << lsf::formatAccumulatedReference(dense.reference)
             << lsf::formatStereoCheck(dense.stereo_check, o.stereo_check_px) << "\n";
   std::cout << "Dense protocol: " << secondsSince(t) << " s"

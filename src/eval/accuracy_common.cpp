@@ -196,7 +196,8 @@ void scoreDepthCaseAgainst(const DepthCase& c, const std::vector<DepthTarget>& t
     masks.setInBothViews(depthToDisparity(target.reference, camera));
     for (const auto& [name, run] : runs) {
       target.acc.add(name, scoreRegions(run.first, target.reference, masks, camera),
-                     rawCoverage(run.first, target.reference), run.second);
+                     rawCoverage(run.first, target.reference), run.second,
+                     edgeSides(run.first, target.reference, MapKind::kDepth));
     }
   }
 }

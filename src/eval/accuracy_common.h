@@ -57,8 +57,9 @@ template <typename Metrics>
 class LayoutAccumulator {
  public:
   void add(const std::string& method, const RegionScores<Metrics>& scores, double raw_coverage,
-           double seconds) {
+           double seconds, const EdgeSides& edge_sides) {
     MethodScores<Metrics>& m = rows_[method];
+    m.edge_sides += edge_sides;
     m.name = method;
     m.per_item.push_back(scores);
     m.raw_coverage += raw_coverage;

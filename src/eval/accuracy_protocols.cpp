@@ -85,7 +85,8 @@ void scoreMiddleburyLayout(const MiddleburyScene& scene, const std::string& scen
   std::vector<std::pair<std::string, cv::Mat1f>> saved;  // saveCase's outputs
   const auto add = [&](const std::string& name, const cv::Mat1f& disparity, double seconds) {
     acc.add(name, scoreRegions(disparity, scene.disparity, masks),
-            rawCoverage(disparity, scene.disparity), seconds);
+            rawCoverage(disparity, scene.disparity), seconds,
+            edgeSides(disparity, scene.disparity, MapKind::kDisparity));
     if (!options.save_dir.empty()) saved.push_back({name, disparity});
   };
   std::map<std::string, cv::Mat1f> results;

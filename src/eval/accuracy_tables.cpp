@@ -2,6 +2,7 @@
 #include "lidar_stereo_fusion/eval/accuracy_tables.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <utility>
 
@@ -126,6 +127,36 @@ std::string formatDepthBands(const LayoutScores<DepthMetrics>& layout) {
   return regionTable(layout, kBands, "MAE mm", "RMSE mm", [](const DepthMetrics& m) {
     return std::make_pair(format("%.0f", m.mae_mm), format("%.0f", m.rmse_mm));
   });
+}
+
+namespace {
+
+template <typename Metrics>
+std::string edgeSidesTable(const LayoutScores<Metrics>& layout) {
+  const std::vector<std::string> header = {
+      "method",  "own edge pixels with a reference",     "reference near %", "far %", "between %",
+      "other %", "share of the method's squared error %"};
+  std::string out = row(header) + separator(header.size());
+  for (const MethodScores<Metrics>& m : layout.methods) {
+    const EdgeSides& e = m.edge_sides;
+    const double n = static_cast<double>(std::max<int64_t>(1, e.pixels));
+    out += row(
+        {m.name, std::to_string(e.pixels), format("%.1f", 100 * e.near / n),
+         format("%.1f", 100 * e.far / n), format("%.1f", 100 * e.between / n),
+         format("%.1f", 100 * e.other / n),
+         format("%.1f", e.total_sq_error > 0 ? 100 * e.edge_sq_error / e.total_sq_error : 0.0)});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string formatEdgeSides(const LayoutScores<DisparityMetrics>& layout) {
+  return edgeSidesTable(layout);
+}
+
+std::string formatEdgeSides(const LayoutScores<DepthMetrics>& layout) {
+  return edgeSidesTable(layout);
 }
 
 std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference) {

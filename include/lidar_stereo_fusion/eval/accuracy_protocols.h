@@ -57,6 +57,7 @@
 #include "lidar_stereo_fusion/core/lidar_projection.h"
 #include "lidar_stereo_fusion/core/metrics.h"
 #include "lidar_stereo_fusion/core/pipeline.h"
+#include "lidar_stereo_fusion/eval/edge_sides.h"
 #include "lidar_stereo_fusion/eval/sweep_order.h"
 
 namespace lidar_stereo_fusion {
@@ -129,6 +130,9 @@ struct MethodScores {
   /// Wall time of the method over all items [s]. pms uses no LiDAR: it runs once per scene /
   /// frame and that run's time is reported in every layout.
   double seconds = 0;
+  /// Where the reference's surface lies at the method's own depth edges, summed over the items
+  /// (eval/edge_sides.h).
+  EdgeSides edge_sides;
 };
 
 /// One layout (a pseudo-LiDAR of a given density, a ring subset) of one protocol.

@@ -31,6 +31,12 @@ std::string formatKittiRegions(const LayoutScores<DepthMetrics>& layout);
 /// band's share of the reference pixels [%].
 std::string formatDepthBands(const LayoutScores<DepthMetrics>& layout);
 
+/// Edge-sides table (eval/edge_sides.h): rows = methods, the method's own edge pixels with a
+/// reference (summed over the items), the share of them where the reference has the near surface,
+/// the far one, a value between or another, and the share of the method's squared error on them.
+std::string formatEdgeSides(const LayoutScores<DisparityMetrics>& layout);
+std::string formatEdgeSides(const LayoutScores<DepthMetrics>& layout);
+
 /// How an accumulated reference was built (eval/kitti_accumulated.h), as a two-column table.
 std::string formatAccumulatedReference(const kitti::AccumulatedDepth& reference);
 
