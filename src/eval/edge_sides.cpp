@@ -20,6 +20,8 @@ EdgeSides& EdgeSides::operator+=(const EdgeSides& o) {
 
 namespace {
 
+constexpr int kDy[4] = {-1, 1, 0, 0}, kDx[4] = {0, 0, -1, 1};  ///< the 4-neighbours
+
 bool hasValue(float v) { return std::isfinite(v) && v > 0.f; }
 
 /// The value as a depth-like quantity (larger = farther).
@@ -48,9 +50,8 @@ EdgeSides edgeSides(const cv::Mat1f& output, const cv::Mat1f& reference, MapKind
       if (!hasValue(v)) continue;
       const double zp = farness(v, kind);
       double zq = zp;  // the nearest 4-neighbour with a value
-      const int dy[] = {-1, 1, 0, 0}, dx[] = {0, 0, -1, 1};
       for (int k = 0; k < 4; ++k) {
-        const int yy = y + dy[k], xx = x + dx[k];
+        const int yy = y + kDy[k], xx = x + kDx[k];
         if (yy < 0 || yy >= rows || xx < 0 || xx >= cols || !hasValue(filled(yy, xx))) continue;
         zq = std::min(zq, farness(filled(yy, xx), kind));
       }

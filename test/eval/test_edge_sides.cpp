@@ -17,6 +17,15 @@ cv::Mat1f twoSurfaces(float far_value, float near_value) {
   return m;
 }
 
+/// Row 2's four edge pixels, one reference of each class.
+void expectOneOfEachOnRowTwo(const EdgeSides& s) {
+  EXPECT_EQ(s.pixels, 4);
+  EXPECT_EQ(s.near, 1);
+  EXPECT_EQ(s.far, 1);
+  EXPECT_EQ(s.between, 1);
+  EXPECT_EQ(s.other, 1);
+}
+
 TEST(EdgeSides, DepthOutputCountsEachClassOfTheReferenceOnRowTwo) {
   const cv::Mat1f out = twoSurfaces(20.f, 10.f);
   cv::Mat1f ref(6, 4, 0.f);
@@ -27,11 +36,7 @@ TEST(EdgeSides, DepthOutputCountsEachClassOfTheReferenceOnRowTwo) {
   ref(0, 0) = 21.f;   // not an edge pixel: only the total
   ref(4, 1) = 10.f;   // near side, no error
   const EdgeSides s = edgeSides(out, ref, MapKind::kDepth);
-  EXPECT_EQ(s.pixels, 4);
-  EXPECT_EQ(s.near, 1);
-  EXPECT_EQ(s.far, 1);
-  EXPECT_EQ(s.between, 1);
-  EXPECT_EQ(s.other, 1);
+  expectOneOfEachOnRowTwo(s);
   EXPECT_DOUBLE_EQ(s.edge_sq_error, 100.0 + 0.25 + 25.0 + 225.0);
   EXPECT_DOUBLE_EQ(s.total_sq_error, 100.0 + 0.25 + 25.0 + 225.0 + 1.0);
 }
@@ -44,11 +49,7 @@ TEST(EdgeSides, DisparityIsComparedAsItsDepthAndErrorsStayInPixels) {
   ref(2, 2) = 7.f;   // between (1 / 7 is in neither tolerance)
   ref(2, 3) = 20.f;  // other: nearer than the near surface
   const EdgeSides s = edgeSides(out, ref, MapKind::kDisparity);
-  EXPECT_EQ(s.pixels, 4);
-  EXPECT_EQ(s.near, 1);
-  EXPECT_EQ(s.far, 1);
-  EXPECT_EQ(s.between, 1);
-  EXPECT_EQ(s.other, 1);
+  expectOneOfEachOnRowTwo(s);
   EXPECT_NEAR(s.edge_sq_error, 25.0 + 0.04 + 4.0 + 225.0, 1e-4);
 }
 
