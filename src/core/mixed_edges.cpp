@@ -105,8 +105,7 @@ int nearerAtMixedEdges(cv::Mat1f& disparity, const cv::Mat& image, const cv::Mat
         }
         if (!flag[x]) continue;
         const float d = disparity(y, x);
-        if (!sparse.empty() && isMeasuredPoint(sparse(y, x), lines(y, x)) &&
-            std::abs(d - sparse(y, x)) <= tolerance) {
+        if (!sparse.empty() && keepsMeasuredPoint(d, sparse(y, x), lines(y, x), tolerance)) {
           continue;  // a LiDAR point the output agrees with
         }
         float nearer = d;

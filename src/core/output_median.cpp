@@ -82,8 +82,7 @@ cv::Mat1f medianKeepingMeasured(const cv::Mat1f& disparity, int size, const cv::
     const float* d = disparity[y];
     float* o = out[y];
     for (int x = 0; x < disparity.cols; ++x) {
-      if (isMeasuredPoint(s[x], l[x]) && d[x] > 0.f && std::abs(d[x] - s[x]) <= tolerance)
-        o[x] = d[x];
+      if (keepsMeasuredPoint(d[x], s[x], l[x], tolerance)) o[x] = d[x];
     }
   }
   return out;

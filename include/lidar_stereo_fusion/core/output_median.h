@@ -9,6 +9,8 @@
 // speckle, and a plain median erased one-pixel-wide poles the LiDAR had measured.
 #pragma once
 
+#include <cmath>
+
 #include <opencv2/core.hpp>
 
 namespace lidar_stereo_fusion {
@@ -22,6 +24,13 @@ cv::Mat1f medianOfValues(const cv::Mat1f& disparity, int size);
 
 /// Whether a projected point (`sparse`, > 0) is still on the scan lines (`lines`) with its value.
 inline bool isMeasuredPoint(float sparse, float line) { return sparse > 0.f && sparse == line; }
+
+/// Whether `disparity` (> 0) keeps a measured point's value within `tolerance` [px]: the LiDAR
+/// points that the output median and the mixed edge step leave as they are.
+inline bool keepsMeasuredPoint(float disparity, float sparse, float line, float tolerance) {
+  return isMeasuredPoint(sparse, line) && disparity > 0.f &&
+         std::abs(disparity - sparse) <= tolerance;
+}
 
 /// The LiDAR points a median must not move: `sparse` (the projection, nearest point per pixel)
 /// where the scan lines after Algorithm 1 (`lines`) still hold that very value (Algorithm 1 did
